@@ -1,0 +1,1 @@
+//! Estimators: interchangeable ways of estimating the pixel integrals (DESIGN.md §3).

@@ -1,0 +1,24 @@
+//! An RGB float image (linear radiance), row-major with row 0 at the top.
+
+use crate::math::Rgb;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<Rgb>,
+}
+
+impl Image {
+    pub fn new(width: u32, height: u32) -> Self {
+        Image { width, height, pixels: vec![Rgb::BLACK; width as usize * height as usize] }
+    }
+
+    pub fn get(&self, x: u32, y: u32) -> Rgb {
+        self.pixels[y as usize * self.width as usize + x as usize]
+    }
+
+    pub fn set(&mut self, x: u32, y: u32, value: Rgb) {
+        self.pixels[y as usize * self.width as usize + x as usize] = value;
+    }
+}

@@ -1,0 +1,1 @@
+//! Tone mapping for previews.

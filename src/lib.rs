@@ -1,0 +1,18 @@
+//! mltbench: a research bench for light-transport estimators.
+//!
+//! Data flows one way: scene file → `scene::Scene` → estimator passes → `film::Film` →
+//! `image::Image` → files. See DESIGN.md for the map of the crate.
+
+pub mod camera;
+pub mod error;
+pub mod estimator;
+pub mod film;
+pub mod geometry;
+pub mod image;
+pub mod io;
+pub mod math;
+pub mod render;
+pub mod sampler;
+pub mod scene;
+
+pub use error::{Error, Result};

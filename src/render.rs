@@ -1,0 +1,1 @@
+//! Running an estimator for a number of passes or a time budget.

@@ -1,0 +1,274 @@
+//! The scene as read from a file: plain data, no acceleration structures.
+//! The Mitsuba loader produces a `SceneDescription`; `Scene::build` turns it into something
+//! that can be rendered. Keeping the two apart lets tests compare what a file *says* (this
+//! type) with what it *renders*.
+
+use glam::{Vec2, Vec3};
+
+use crate::math::{Rgb, Transform};
+
+/// Everything a scene file describes, in world space.
+#[derive(Clone, Debug, Default)]
+pub struct SceneDescription {
+    /// The scene file this came from (for messages and reference hashes).
+    pub source: std::path::PathBuf,
+    /// Every file that was read to build this scene (the scene, includes, meshes), in order.
+    pub files_read: Vec<std::path::PathBuf>,
+    pub integrator: IntegratorDesc,
+    pub sensor: SensorDesc,
+    pub shapes: Vec<ShapeDesc>,
+    /// Indexed by `ShapeDesc::bsdf`.
+    pub bsdfs: Vec<BsdfDesc>,
+    /// Area emitters point back at their shape; the others stand alone.
+    pub emitters: Vec<EmitterDesc>,
+    /// Degenerate (zero-area) triangles dropped while loading meshes.
+    pub skipped_triangles: usize,
+    /// Non-fatal remarks (e.g. "rfilter tent: using box"), each naming file and line.
+    pub warnings: Vec<String>,
+}
+
+/// `<integrator>`: only the path-length settings matter; mltbench picks the estimator.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IntegratorDesc {
+    /// Mitsuba 3 meaning: path segments, 1 = emitters seen directly, -1 = unbounded.
+    pub max_depth: i32,
+    /// Depth from which Russian roulette starts (Mitsuba default 5).
+    pub rr_depth: u32,
+}
+
+impl Default for IntegratorDesc {
+    fn default() -> Self {
+        IntegratorDesc { max_depth: -1, rr_depth: 5 }
+    }
+}
+
+/// Which image axis `fov` spans (Mitsuba's `fov_axis`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FovAxis {
+    #[default]
+    X,
+    Y,
+    Diagonal,
+    Smaller,
+    Larger,
+}
+
+/// `<sensor>` with its `<film>` and `<sampler>`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SensorDesc {
+    /// Camera to world; the camera looks down +z with +y up (Mitsuba convention).
+    pub to_world: Transform,
+    /// Field of view in degrees along `fov_axis`.
+    pub fov_degrees: f32,
+    pub fov_axis: FovAxis,
+    pub near_clip: f32,
+    pub far_clip: f32,
+    pub film: FilmDesc,
+    /// `<sampler sample_count>`: the default samples per pixel.
+    pub sample_count: u32,
+}
+
+impl Default for SensorDesc {
+    fn default() -> Self {
+        SensorDesc {
+            to_world: Transform::IDENTITY,
+            fov_degrees: 39.597755, // Mitsuba: 50mm focal length on a 36mm-wide film, along x
+            fov_axis: FovAxis::X,
+            near_clip: 1e-2,
+            far_clip: 1e4,
+            film: FilmDesc::default(),
+            sample_count: 4,
+        }
+    }
+}
+
+/// `<film type="hdrfilm">`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FilmDesc {
+    pub width: u32,
+    pub height: u32,
+    pub filter: FilterDesc,
+}
+
+impl Default for FilmDesc {
+    fn default() -> Self {
+        FilmDesc { width: 768, height: 576, filter: FilterDesc::default() }
+    }
+}
+
+/// Pixel reconstruction filter (`<rfilter>`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FilterDesc {
+    /// A sample adds to its own pixel only.
+    Box,
+    /// Mitsuba 3's default: a Gaussian of standard deviation `stddev` pixels, cut at 4 σ.
+    Gaussian { stddev: f32 },
+}
+
+impl Default for FilterDesc {
+    fn default() -> Self {
+        FilterDesc::Gaussian { stddev: 0.5 }
+    }
+}
+
+/// A reflectance or other colour parameter. Only constants for now; bitmap textures later.
+pub type ColorParam = Rgb;
+
+/// Index of refraction pair of a dielectric interface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IorPair {
+    pub int_ior: f32,
+    pub ext_ior: f32,
+}
+
+/// Microfacet normal distribution.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MicrofacetKind {
+    Beckmann,
+    Ggx,
+}
+
+/// Microfacet roughness: α along u and v (isotropic: equal).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Roughness {
+    pub kind: MicrofacetKind,
+    pub alpha_u: f32,
+    pub alpha_v: f32,
+    /// Mitsuba's `sample_visible` (default true).
+    pub sample_visible: bool,
+}
+
+/// A BSDF as described in the scene file (evaluation lives in `material/`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum BsdfDesc {
+    Diffuse {
+        reflectance: ColorParam,
+    },
+    /// Smooth conductor. `eta`/`k` complex IOR per channel; `material="none"` gives
+    /// `eta = k = None`: a perfect mirror (reflectance 1, no Fresnel term).
+    Conductor {
+        eta_k: Option<(Rgb, Rgb)>,
+        specular_reflectance: ColorParam,
+    },
+    RoughConductor {
+        eta_k: Option<(Rgb, Rgb)>,
+        specular_reflectance: ColorParam,
+        roughness: Roughness,
+    },
+    Dielectric {
+        ior: IorPair,
+        specular_reflectance: ColorParam,
+        specular_transmittance: ColorParam,
+    },
+    ThinDielectric {
+        ior: IorPair,
+        specular_reflectance: ColorParam,
+        specular_transmittance: ColorParam,
+    },
+    RoughDielectric {
+        ior: IorPair,
+        roughness: Roughness,
+        specular_reflectance: ColorParam,
+        specular_transmittance: ColorParam,
+    },
+    Plastic {
+        ior: IorPair,
+        diffuse_reflectance: ColorParam,
+        specular_reflectance: ColorParam,
+        nonlinear: bool,
+    },
+    RoughPlastic {
+        ior: IorPair,
+        diffuse_reflectance: ColorParam,
+        specular_reflectance: ColorParam,
+        roughness: Roughness,
+        nonlinear: bool,
+    },
+    /// The same BSDF on both sides (Mitsuba `twosided`); may name a different back BSDF.
+    TwoSided {
+        front: Box<BsdfDesc>,
+        back: Box<BsdfDesc>,
+    },
+    /// Index-matched boundary: rays pass straight through.
+    Null,
+    /// mltbench extensions: classic glossy models of the lecture (Phong, Blinn-Phong, Ward).
+    Phong {
+        exponent: f32,
+        diffuse_reflectance: ColorParam,
+        specular_reflectance: ColorParam,
+    },
+    Blinn {
+        exponent: f32,
+        diffuse_reflectance: ColorParam,
+        specular_reflectance: ColorParam,
+    },
+    Ward {
+        alpha_u: f32,
+        alpha_v: f32,
+        diffuse_reflectance: ColorParam,
+        specular_reflectance: ColorParam,
+    },
+}
+
+impl BsdfDesc {
+    /// The diffuse albedo used by the `eyelight` preview, or None for non-diffuse BSDFs.
+    pub fn diffuse_albedo(&self) -> Option<Rgb> {
+        match self {
+            BsdfDesc::Diffuse { reflectance } => Some(*reflectance),
+            BsdfDesc::TwoSided { front, .. } => front.diffuse_albedo(),
+            _ => None,
+        }
+    }
+}
+
+/// Emitters. Area emitters are attached to a shape (`ShapeDesc::emitter`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum EmitterDesc {
+    /// Uniform radiance on the front side of shape `shape`.
+    Area { radiance: Rgb, shape: usize },
+    /// Isotropic point light of radiant intensity `intensity` (W/sr).
+    Point { intensity: Rgb, position: Vec3 },
+    /// Distant light along `direction` (the way light travels) with irradiance `irradiance`.
+    Directional { irradiance: Rgb, direction: Vec3 },
+    /// Uniform radiance from every direction at infinity.
+    Constant { radiance: Rgb },
+}
+
+/// A triangle mesh in world space. Invariant: indices are in range, triangles have area > 0.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriangleMesh {
+    pub positions: Vec<Vec3>,
+    /// Per-vertex shading normals (unit length), when the mesh has them and
+    /// `face_normals` is false.
+    pub normals: Option<Vec<Vec3>>,
+    pub uvs: Option<Vec<Vec2>>,
+    pub indices: Vec<[u32; 3]>,
+}
+
+/// The geometry of a shape, already in world space.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShapeGeometry {
+    Mesh(TriangleMesh),
+    /// Analytic sphere (not tessellated).
+    Sphere { center: Vec3, radius: f32 },
+    /// Analytic disk: the unit disk in the local xy plane (normal +z) under `to_world`.
+    Disk { to_world: Transform },
+}
+
+/// A shape with its material, emitter and media.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ShapeDesc {
+    /// The `id` attribute, or `type@file:line` when it has none; for messages.
+    pub name: String,
+    pub geometry: ShapeGeometry,
+    /// Index into `SceneDescription::bsdfs` (a shape with no BSDF gets a white diffuse one,
+    /// as in Mitsuba).
+    pub bsdf: usize,
+    /// Index into `SceneDescription::emitters` of its area emitter.
+    pub emitter: Option<usize>,
+    /// Normals point inward instead of outward (already applied to mesh normals and winding;
+    /// for analytic shapes the intersector reads it).
+    pub flip_normals: bool,
+    pub interior_medium: Option<String>,
+    pub exterior_medium: Option<String>,
+}

@@ -1,0 +1,43 @@
+//! Scenes: the description read from a file, and the built, renderable `Scene`.
+
+pub mod description;
+pub mod mitsuba;
+pub mod obj;
+pub mod ply;
+pub mod spectra;
+
+use std::path::Path;
+
+pub use description::*;
+
+use crate::camera::Camera;
+use crate::error::Result;
+use crate::geometry::Geometry;
+
+/// A scene ready to render: immutable and shared by all threads.
+pub struct Scene {
+    pub description: SceneDescription,
+    pub geometry: Geometry,
+    pub camera: Camera,
+}
+
+impl Scene {
+    /// Reads a Mitsuba 3 XML scene and builds it.
+    pub fn load(path: &Path) -> Result<Scene> {
+        Scene::build(mitsuba::load_file(path)?)
+    }
+
+    pub fn build(description: SceneDescription) -> Result<Scene> {
+        let geometry = Geometry::build(&description.shapes);
+        let camera = Camera::new(&description.sensor);
+        Ok(Scene { description, geometry, camera })
+    }
+
+    pub fn width(&self) -> u32 {
+        self.description.sensor.film.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.description.sensor.film.height
+    }
+}
