@@ -1,1 +1,52 @@
 //! Running an estimator for a number of passes or a time budget.
+
+use std::time::{Duration, Instant};
+
+use crate::estimator::{Estimator, Stats};
+use crate::image::Image;
+use crate::scene::Scene;
+
+/// How much work to do.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Budget {
+    /// Exactly this many passes (equal work; reproducible bit for bit).
+    Passes(u32),
+    /// Passes until this much wall-clock time has gone by (equal time; at least one pass).
+    Seconds(f64),
+}
+
+/// What a finished render hands back.
+pub struct RenderOutput {
+    pub image: Image,
+    pub stats: Stats,
+    pub seconds: f64,
+}
+
+/// Runs `estimator` on `scene` until `budget` is spent. `on_pass(done, elapsed)` is called
+/// after every pass (for progress bars).
+pub fn render(
+    scene: &Scene,
+    estimator: &mut dyn Estimator,
+    budget: Budget,
+    mut on_pass: impl FnMut(u32, Duration),
+) -> RenderOutput {
+    let start = Instant::now();
+    let mut pass = 0u32;
+    loop {
+        let done = match budget {
+            Budget::Passes(n) => pass >= n,
+            Budget::Seconds(s) => pass > 0 && start.elapsed().as_secs_f64() >= s,
+        };
+        if done {
+            break;
+        }
+        estimator.run_pass(scene, pass);
+        pass += 1;
+        on_pass(pass, start.elapsed());
+    }
+    RenderOutput {
+        image: estimator.image(),
+        stats: estimator.stats(),
+        seconds: start.elapsed().as_secs_f64(),
+    }
+}

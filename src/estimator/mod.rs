@@ -1,1 +1,62 @@
 //! Estimators: interchangeable ways of estimating the pixel integrals (DESIGN.md §3).
+//!
+//! An estimator is progressive: each `run_pass` adds work, `image` is the current estimate.
+//! Every random number is drawn from a seed-keyed `Sampler`, and work is cut into pieces that
+//! do not depend on the thread count, so a (scene, estimator, parameters, seed, passes)
+//! tuple always gives the same bits.
+
+pub mod camera_pass;
+pub mod eyelight;
+pub mod params;
+
+pub use params::Params;
+
+use crate::error::{Error, Result};
+use crate::image::Image;
+use crate::scene::Scene;
+
+/// Counters an estimator reports; experiments read them to normalise by work done.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Stats {
+    pub passes: u64,
+    /// Camera paths (camera-side estimators) or light paths (light tracing, photons).
+    pub samples: u64,
+    /// Rays cast (closest hit and shadow rays).
+    pub rays: u64,
+    /// Samples that came out NaN, infinite or negative: dropped, never written to the film.
+    pub invalid_samples: u64,
+}
+
+pub trait Estimator: Send {
+    /// The estimator's name as given on the command line (`pt`, `eyelight`, …).
+    fn name(&self) -> &str;
+    /// Adds one pass of work (for camera estimators: one sample per pixel).
+    fn run_pass(&mut self, scene: &Scene, pass_index: u32);
+    /// The current estimate of radiance per pixel.
+    fn image(&self) -> Image;
+    fn stats(&self) -> Stats;
+}
+
+/// Names of the estimators this build knows, for `--help` and error messages.
+pub const ESTIMATOR_NAMES: &[&str] = &["eyelight"];
+
+/// Makes the estimator called `name`, reading its parameters from `params`.
+/// Fails on an unknown name or a parameter the estimator does not have.
+pub fn create(
+    name: &str,
+    params: &Params,
+    scene: &Scene,
+    seed: u64,
+) -> Result<Box<dyn Estimator>> {
+    let estimator: Box<dyn Estimator> = match name {
+        "eyelight" => Box::new(eyelight::EyeLight::new(scene, seed)),
+        _ => {
+            return Err(Error::usage(format!(
+                "unknown estimator '{name}' (known: {})",
+                ESTIMATOR_NAMES.join(", ")
+            )));
+        }
+    };
+    params.check_all_used(name)?;
+    Ok(estimator)
+}

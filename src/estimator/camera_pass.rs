@@ -1,0 +1,90 @@
+//! One pass of a camera-side estimator: every pixel takes one sample, tile by tile.
+//!
+//! Tiles have a fixed size (not tied to the thread count), each pixel sample seeds its own
+//! random stream from (seed, pixel, sample index), and finished tiles merge into the film in
+//! tile order: the image is bit-identical for any number of threads (DESIGN.md §3).
+
+use rayon::prelude::*;
+
+use crate::film::{Film, FilmTile, PixelRect};
+use crate::geometry::Ray;
+use crate::math::{Rgb, Vec2};
+use crate::sampler::{IndependentSampler, Sampler};
+use crate::scene::Scene;
+
+/// Edge length of a tile in pixels.
+pub const TILE_SIZE: u32 = 16;
+
+/// Per-pass counters returned by `camera_pass`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct PassCounts {
+    pub samples: u64,
+    pub rays: u64,
+    pub invalid: u64,
+}
+
+/// What an estimator computes for one camera sample: the radiance along `ray`,
+/// and the number of rays it cast.
+pub trait CameraSampleFn: Sync {
+    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut IndependentSampler) -> (Rgb, u64);
+}
+
+/// The tiles that cover a `width` × `height` image, in scanline order.
+pub fn tiles(width: u32, height: u32) -> Vec<PixelRect> {
+    let mut rects = Vec::new();
+    for y0 in (0..height).step_by(TILE_SIZE as usize) {
+        for x0 in (0..width).step_by(TILE_SIZE as usize) {
+            rects.push(PixelRect {
+                x0,
+                y0,
+                x1: (x0 + TILE_SIZE).min(width),
+                y1: (y0 + TILE_SIZE).min(height),
+            });
+        }
+    }
+    rects
+}
+
+/// Takes sample number `pass_index` of every pixel and adds it to `film`.
+/// Samples that are NaN, infinite or negative are dropped and counted.
+pub fn camera_pass(
+    scene: &Scene,
+    film: &mut Film,
+    seed: u64,
+    pass_index: u32,
+    estimate: &impl CameraSampleFn,
+) -> PassCounts {
+    let rects = tiles(scene.width(), scene.height());
+    let finished: Vec<(FilmTile, PassCounts)> = rects
+        .par_iter()
+        .map(|&rect| {
+            let mut tile = film.tile(rect);
+            let mut counts = PassCounts::default();
+            let mut sampler = IndependentSampler::new(seed);
+            for y in rect.y0..rect.y1 {
+                for x in rect.x0..rect.x1 {
+                    sampler.start_pixel_sample((x, y), pass_index as u64);
+                    let raster = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+                    let ray = scene.camera.generate_ray(raster);
+                    let (value, rays) = estimate.radiance(scene, &ray, &mut sampler);
+                    counts.samples += 1;
+                    counts.rays += rays;
+                    if value.is_valid_radiance() {
+                        tile.add_sample(raster, value);
+                    } else {
+                        counts.invalid += 1;
+                    }
+                }
+            }
+            (tile, counts)
+        })
+        .collect();
+    let mut total = PassCounts::default();
+    for (tile, counts) in &finished {
+        film.merge_tile(tile);
+        total.samples += counts.samples;
+        total.rays += counts.rays;
+        total.invalid += counts.invalid;
+    }
+    total
+}

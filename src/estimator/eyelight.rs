@@ -1,0 +1,98 @@
+//! `eyelight`: a preview, not a light-transport estimate. Emitted radiance where the camera
+//! sees an emitter, otherwise the surface's diffuse albedo × |cos θ| between the ray and the
+//! shading normal (0.5 grey for non-diffuse BSDFs). Rays pass through `null` surfaces.
+//! A miss shows the constant environment emitter, if the scene has one, else black.
+
+use super::camera_pass::{CameraSampleFn, camera_pass};
+use super::{Estimator, Stats};
+use crate::film::Film;
+use crate::geometry::Ray;
+use crate::image::Image;
+use crate::math::Rgb;
+use crate::sampler::IndependentSampler;
+use crate::scene::{BsdfDesc, EmitterDesc, Scene};
+
+/// How many `null` surfaces a preview ray may cross before giving up.
+const MAX_NULL_CROSSINGS: u32 = 64;
+
+pub struct EyeLight {
+    film: Film,
+    seed: u64,
+    stats: Stats,
+    background: Rgb,
+}
+
+impl EyeLight {
+    pub fn new(scene: &Scene, seed: u64) -> Self {
+        let sensor = &scene.description.sensor;
+        let background = scene
+            .description
+            .emitters
+            .iter()
+            .map(|e| match e {
+                EmitterDesc::Constant { radiance } => *radiance,
+                _ => Rgb::BLACK,
+            })
+            .fold(Rgb::BLACK, |a, b| a + b);
+        EyeLight {
+            film: Film::new(sensor.film.width, sensor.film.height, sensor.film.filter),
+            seed,
+            stats: Stats::default(),
+            background,
+        }
+    }
+}
+
+struct Shade<'a> {
+    background: &'a Rgb,
+}
+
+impl CameraSampleFn for Shade<'_> {
+    fn radiance(&self, scene: &Scene, ray: &Ray, _: &mut IndependentSampler) -> (Rgb, u64) {
+        let mut ray = *ray;
+        for crossing in 0..=MAX_NULL_CROSSINGS {
+            let Some(hit) = scene.geometry.intersect(&ray) else {
+                return (*self.background, crossing as u64 + 1);
+            };
+            let shape = &scene.description.shapes[hit.shape as usize];
+            let bsdf = &scene.description.bsdfs[shape.bsdf];
+            if matches!(bsdf, BsdfDesc::Null) && shape.emitter.is_none() {
+                ray = hit.spawn_ray(ray.d);
+                continue;
+            }
+            let toward_eye = -ray.d.normalize();
+            if let Some(EmitterDesc::Area { radiance, .. }) =
+                shape.emitter.map(|e| &scene.description.emitters[e])
+                && hit.ng.dot(toward_eye) > 0.0
+            {
+                return (*radiance, crossing as u64 + 1);
+            }
+            let albedo = bsdf.diffuse_albedo().unwrap_or(Rgb::splat(0.5));
+            return (albedo * hit.ns.dot(toward_eye).abs(), crossing as u64 + 1);
+        }
+        (Rgb::BLACK, MAX_NULL_CROSSINGS as u64 + 1)
+    }
+}
+
+impl Estimator for EyeLight {
+    fn name(&self) -> &str {
+        "eyelight"
+    }
+
+    fn run_pass(&mut self, scene: &Scene, pass_index: u32) {
+        let shade = Shade { background: &self.background };
+        let counts = camera_pass(scene, &mut self.film, self.seed, pass_index, &shade);
+        self.stats.passes += 1;
+        self.stats.samples += counts.samples;
+        self.stats.rays += counts.rays;
+        self.stats.invalid_samples += counts.invalid;
+    }
+
+    fn image(&self) -> Image {
+        self.film.image(0.0)
+    }
+
+    fn stats(&self) -> Stats {
+        self.stats.clone()
+    }
+}
