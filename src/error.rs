@@ -16,11 +16,19 @@ pub struct Location {
 
 impl Location {
     pub fn file(file: impl Into<PathBuf>) -> Self {
-        Location { file: file.into(), line: None, element: None }
+        Location {
+            file: file.into(),
+            line: None,
+            element: None,
+        }
     }
 
     pub fn at(file: impl Into<PathBuf>, line: u32, element: impl Into<String>) -> Self {
-        Location { file: file.into(), line: Some(line), element: Some(element.into()) }
+        Location {
+            file: file.into(),
+            line: Some(line),
+            element: Some(element.into()),
+        }
     }
 }
 
@@ -45,7 +53,10 @@ pub enum Error {
     Input { location: Location, message: String },
     /// An operating-system error while reading or writing a file.
     #[error("{}: {source}", path.display())]
-    Io { path: PathBuf, source: std::io::Error },
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
     /// A bad command-line argument or estimator parameter.
     #[error("{0}")]
     Usage(String),
@@ -53,11 +64,17 @@ pub enum Error {
 
 impl Error {
     pub fn input(location: Location, message: impl Into<String>) -> Self {
-        Error::Input { location, message: message.into() }
+        Error::Input {
+            location,
+            message: message.into(),
+        }
     }
 
     pub fn io(path: &Path, source: std::io::Error) -> Self {
-        Error::Io { path: path.to_path_buf(), source }
+        Error::Io {
+            path: path.to_path_buf(),
+            source,
+        }
     }
 
     pub fn usage(message: impl Into<String>) -> Self {

@@ -81,14 +81,22 @@ fn run_render(args: RenderArgs) -> Result<()> {
     if let Some(t) = args.time
         && !(t.is_finite() && t > 0.0)
     {
-        return Err(Error::usage(format!("--time must be a positive number of seconds, got {t}")));
+        return Err(Error::usage(format!(
+            "--time must be a positive number of seconds, got {t}"
+        )));
     }
     if args.spp == Some(0) {
         return Err(Error::usage("--spp must be at least 1"));
     }
-    let output = args.output.clone().unwrap_or_else(|| default_output(&args.scene));
+    let output = args
+        .output
+        .clone()
+        .unwrap_or_else(|| default_output(&args.scene));
     if output.extension().and_then(|e| e.to_str()) != Some("exr") {
-        return Err(Error::usage(format!("output {} must end in .exr", output.display())));
+        return Err(Error::usage(format!(
+            "output {} must end in .exr",
+            output.display()
+        )));
     }
 
     let description = mitsuba::load_file(&args.scene)?;
@@ -117,13 +125,18 @@ fn run_render(args: RenderArgs) -> Result<()> {
 
     let bar = progress_bar(budget);
     let result = pool.install(|| {
-        render(&scene, estimator.as_mut(), budget, |pass, elapsed| match budget {
-            Budget::Passes(_) => bar.set_position(pass as u64),
-            Budget::Seconds(_) => {
-                bar.set_position(elapsed.as_millis() as u64);
-                bar.set_message(format!("{pass} passes"));
-            }
-        })
+        render(
+            &scene,
+            estimator.as_mut(),
+            budget,
+            |pass, elapsed| match budget {
+                Budget::Passes(_) => bar.set_position(pass as u64),
+                Budget::Seconds(_) => {
+                    bar.set_position(elapsed.as_millis() as u64);
+                    bar.set_message(format!("{pass} passes"));
+                }
+            },
+        )
     });
     bar.finish_and_clear();
 
@@ -154,16 +167,26 @@ fn run_render(args: RenderArgs) -> Result<()> {
 
 /// `<scene file stem>.exr` in the working directory.
 fn default_output(scene: &Path) -> PathBuf {
-    let stem = scene.file_stem().map(|s| s.to_os_string()).unwrap_or_else(|| "render".into());
+    let stem = scene
+        .file_stem()
+        .map(|s| s.to_os_string())
+        .unwrap_or_else(|| "render".into());
     PathBuf::from(stem).with_extension("exr")
 }
 
 fn progress_bar(budget: Budget) -> ProgressBar {
     let (length, template) = match budget {
-        Budget::Passes(n) => (n as u64, "{elapsed_precise} [{bar:40}] {pos}/{len} passes, ETA {eta}"),
+        Budget::Passes(n) => (
+            n as u64,
+            "{elapsed_precise} [{bar:40}] {pos}/{len} passes, ETA {eta}",
+        ),
         Budget::Seconds(s) => ((s * 1000.0) as u64, "{elapsed_precise} [{bar:40}] {msg}"),
     };
     let bar = ProgressBar::new(length);
-    bar.set_style(ProgressStyle::with_template(template).expect("valid template").progress_chars("=> "));
+    bar.set_style(
+        ProgressStyle::with_template(template)
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
     bar
 }

@@ -80,7 +80,9 @@ impl Estimator for EyeLight {
     }
 
     fn run_pass(&mut self, scene: &Scene, pass_index: u32) {
-        let shade = Shade { background: &self.background };
+        let shade = Shade {
+            background: &self.background,
+        };
         let counts = camera_pass(scene, &mut self.film, self.seed, pass_index, &shade);
         self.stats.passes += 1;
         self.stats.samples += counts.samples;

@@ -42,12 +42,7 @@ pub const ESTIMATOR_NAMES: &[&str] = &["eyelight"];
 
 /// Makes the estimator called `name`, reading its parameters from `params`.
 /// Fails on an unknown name or a parameter the estimator does not have.
-pub fn create(
-    name: &str,
-    params: &Params,
-    scene: &Scene,
-    seed: u64,
-) -> Result<Box<dyn Estimator>> {
+pub fn create(name: &str, params: &Params, scene: &Scene, seed: u64) -> Result<Box<dyn Estimator>> {
     let estimator: Box<dyn Estimator> = match name {
         "eyelight" => Box::new(eyelight::EyeLight::new(scene, seed)),
         _ => {

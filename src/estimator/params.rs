@@ -26,11 +26,17 @@ impl Params {
             if key.is_empty() {
                 return Err(Error::usage(format!("--set '{pair}': empty key")));
             }
-            if values.insert(key.to_string(), value.trim().to_string()).is_some() {
+            if values
+                .insert(key.to_string(), value.trim().to_string())
+                .is_some()
+            {
                 return Err(Error::usage(format!("--set {key} given twice")));
             }
         }
-        Ok(Params { values, queried: RefCell::default() })
+        Ok(Params {
+            values,
+            queried: RefCell::default(),
+        })
     }
 
     /// The raw value of `key`, if set.
@@ -55,8 +61,12 @@ impl Params {
     /// Fails when a key was set that nothing asked for, naming the estimator.
     pub fn check_all_used(&self, estimator: &str) -> Result<()> {
         let queried = self.queried.borrow();
-        let unknown: Vec<&str> =
-            self.values.keys().filter(|k| !queried.contains(*k)).map(String::as_str).collect();
+        let unknown: Vec<&str> = self
+            .values
+            .keys()
+            .filter(|k| !queried.contains(*k))
+            .map(String::as_str)
+            .collect();
         if unknown.is_empty() {
             Ok(())
         } else {

@@ -17,7 +17,11 @@ pub struct Ray {
 
 impl Ray {
     pub fn new(o: Vec3, d: Vec3) -> Self {
-        Ray { o, d, t_max: f32::INFINITY }
+        Ray {
+            o,
+            d,
+            t_max: f32::INFINITY,
+        }
     }
 
     pub fn at(&self, t: f32) -> Vec3 {

@@ -47,7 +47,9 @@ mod tests {
             let f = Frame::from_normal(n);
             assert!((f.s.length() - 1.0).abs() < 1e-5);
             assert!((f.t.length() - 1.0).abs() < 1e-5);
-            assert!(f.s.dot(f.t).abs() < 1e-5 && f.s.dot(n).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5);
+            assert!(
+                f.s.dot(f.t).abs() < 1e-5 && f.s.dot(n).abs() < 1e-5 && f.t.dot(n).abs() < 1e-5
+            );
             // right-handed: s × t = n
             assert!((f.s.cross(f.t) - n).length() < 1e-5);
             let v = Vec3::new(0.2, 0.7, -0.1);

@@ -15,7 +15,10 @@ impl Default for Transform {
 }
 
 impl Transform {
-    pub const IDENTITY: Transform = Transform { matrix: Mat4::IDENTITY, inverse: Mat4::IDENTITY };
+    pub const IDENTITY: Transform = Transform {
+        matrix: Mat4::IDENTITY,
+        inverse: Mat4::IDENTITY,
+    };
 
     /// None when the matrix is singular or not finite.
     pub fn new(matrix: Mat4) -> Option<Self> {
@@ -23,12 +26,18 @@ impl Transform {
         if !det.is_finite() || det == 0.0 || !matrix.is_finite() {
             return None;
         }
-        Some(Transform { matrix, inverse: matrix.inverse() })
+        Some(Transform {
+            matrix,
+            inverse: matrix.inverse(),
+        })
     }
 
     /// `then` applied after `self`: the composition other · self.
     pub fn then(&self, other: &Transform) -> Transform {
-        Transform { matrix: other.matrix * self.matrix, inverse: self.inverse * other.inverse }
+        Transform {
+            matrix: other.matrix * self.matrix,
+            inverse: self.inverse * other.inverse,
+        }
     }
 
     pub fn point(&self, p: Vec3) -> Vec3 {
@@ -45,7 +54,10 @@ impl Transform {
     }
 
     pub fn inverse(&self) -> Transform {
-        Transform { matrix: self.inverse, inverse: self.matrix }
+        Transform {
+            matrix: self.inverse,
+            inverse: self.matrix,
+        }
     }
 
     /// True when the transform flips orientation (negative determinant).

@@ -17,7 +17,9 @@ pub fn mix64(mut z: u64) -> u64 {
 
 /// Hashes a list of words into one seed; order matters.
 pub fn hash_words(words: &[u64]) -> u64 {
-    words.iter().fold(0x6A09_E667_F3BC_C909, |h, &w| mix64(h ^ mix64(w)))
+    words
+        .iter()
+        .fold(0x6A09_E667_F3BC_C909, |h, &w| mix64(h ^ mix64(w)))
 }
 
 /// Uniform random samples, seeded from (seed, pixel, sample index).
@@ -28,7 +30,10 @@ pub struct IndependentSampler {
 
 impl IndependentSampler {
     pub fn new(seed: u64) -> Self {
-        IndependentSampler { seed, rng: Xoshiro256PlusPlus::seed_from_u64(seed) }
+        IndependentSampler {
+            seed,
+            rng: Xoshiro256PlusPlus::seed_from_u64(seed),
+        }
     }
 
     /// Re-seeds the stream from any list of words (used for non-pixel streams such as

@@ -38,7 +38,10 @@ pub struct IntegratorDesc {
 
 impl Default for IntegratorDesc {
     fn default() -> Self {
-        IntegratorDesc { max_depth: -1, rr_depth: 5 }
+        IntegratorDesc {
+            max_depth: -1,
+            rr_depth: 5,
+        }
     }
 }
 
@@ -92,7 +95,11 @@ pub struct FilmDesc {
 
 impl Default for FilmDesc {
     fn default() -> Self {
-        FilmDesc { width: 768, height: 576, filter: FilterDesc::default() }
+        FilmDesc {
+            width: 768,
+            height: 576,
+            filter: FilterDesc::default(),
+        }
     }
 }
 
@@ -250,9 +257,14 @@ pub struct TriangleMesh {
 pub enum ShapeGeometry {
     Mesh(TriangleMesh),
     /// Analytic sphere (not tessellated).
-    Sphere { center: Vec3, radius: f32 },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
     /// Analytic disk: the unit disk in the local xy plane (normal +z) under `to_world`.
-    Disk { to_world: Transform },
+    Disk {
+        to_world: Transform,
+    },
 }
 
 /// A shape with its material, emitter and media.

@@ -30,7 +30,11 @@ impl Scene {
     pub fn build(description: SceneDescription) -> Result<Scene> {
         let geometry = Geometry::build(&description.shapes);
         let camera = Camera::new(&description.sensor);
-        Ok(Scene { description, geometry, camera })
+        Ok(Scene {
+            description,
+            geometry,
+            camera,
+        })
     }
 
     pub fn width(&self) -> u32 {

@@ -1,0 +1,214 @@
+//! End-to-end: scene file → estimator → image, determinism across thread counts, the camera
+//! model checked against a hand computation, and the command line's behaviour on bad input.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use mltbench::estimator::{self, Params};
+use mltbench::image::Image;
+use mltbench::render::{Budget, render};
+use mltbench::scene::{Scene, mitsuba};
+
+fn scenes_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/scenes")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mltbench-render-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Loads a scene file with its `res`/`spp` defaults overridden by rewriting the text.
+fn load_small(path: &Path, res: u32) -> Scene {
+    let text = std::fs::read_to_string(path).unwrap();
+    let text = text.replace(
+        "<default name=\"res\" value=\"256\"/>",
+        &format!("<default name=\"res\" value=\"{res}\"/>"),
+    );
+    Scene::build(mitsuba::load_str(&text, path).unwrap()).unwrap()
+}
+
+fn render_with_threads(scene: &Scene, name: &str, threads: usize, passes: u32) -> Image {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    let mut est = estimator::create(name, &Params::default(), scene, 7).unwrap();
+    pool.install(|| render(scene, est.as_mut(), Budget::Passes(passes), |_, _| {}))
+        .image
+}
+
+fn bits(image: &Image) -> Vec<u32> {
+    image
+        .pixels
+        .iter()
+        .flat_map(|p| p.0.map(f32::to_bits))
+        .collect()
+}
+
+#[test]
+fn one_and_two_threads_give_bit_identical_images() {
+    // A Gaussian filter spreads samples across tile borders: the hardest case for
+    // determinism. The film falls back to Mitsuba's default Gaussian when the
+    // rfilter line is removed.
+    let path = scenes_dir().join("cbox-spheres.xml");
+    let text = std::fs::read_to_string(&path)
+        .unwrap()
+        .replace("<rfilter type=\"box\"/>", "");
+    let text = text.replace("value=\"256\"", "value=\"40\"");
+    let scene = Scene::build(mitsuba::load_str(&text, &path).unwrap()).unwrap();
+    let one = render_with_threads(&scene, "eyelight", 1, 3);
+    let two = render_with_threads(&scene, "eyelight", 2, 3);
+    assert_eq!(bits(&one), bits(&two));
+    assert!(one.pixels.iter().any(|p| !p.is_black()));
+}
+
+#[test]
+fn every_builtin_scene_renders_a_finite_image() {
+    for entry in std::fs::read_dir(scenes_dir()).unwrap() {
+        let path = entry.unwrap().path();
+        if path.extension().and_then(|e| e.to_str()) != Some("xml") {
+            continue;
+        }
+        let scene = load_small(&path, 24);
+        let image = render_with_threads(&scene, "eyelight", 2, 2);
+        let lit = image.pixels.iter().filter(|p| !p.is_black()).count();
+        assert!(
+            image.pixels.iter().all(|p| p.is_valid_radiance()),
+            "{}",
+            path.display()
+        );
+        // The box fills most of the frame: most pixels see a wall.
+        assert!(
+            lit * 2 > image.pixels.len(),
+            "{}: only {lit} lit pixels",
+            path.display()
+        );
+    }
+}
+
+/// A small emitting square placed where Mitsuba's documented perspective model says pixel
+/// (16, 12) of a 64×32 image looks, and nothing else in the scene.
+///
+/// Hand computation. The camera sits at the origin looking down +z with +y up (lookat), so
+/// its `left` axis is up × dir = +x, and Mitsuba's camera-to-sample transform puts camera +x
+/// at the image's left and +y at its top. fov = 90° along x: a direction (x, y, 1) lands at
+/// raster (W/2 − x·(W/2)/tan 45°, H/2 − y·(W/2)/tan 45°) = (32 − 32x, 16 − 32y) (square
+/// pixels). The centre of pixel (16, 12) is raster (16.5, 12.5): x = 15.5/32 = 0.484375,
+/// y = 3.5/32 = 0.109375, so at depth z = 2 the point (0.96875, 0.21875, 2).
+/// The square's half-width 0.02 at z = 2 spans 0.32 pixels: it stays inside that pixel.
+#[test]
+fn a_marker_lands_on_the_pixel_computed_by_hand() {
+    let xml = r#"<scene version="3.0.0">
+        <sensor type="perspective">
+            <float name="fov" value="90"/>
+            <transform name="to_world"><lookat origin="0,0,0" target="0,0,1" up="0,1,0"/></transform>
+            <sampler type="independent"><integer name="sample_count" value="16"/></sampler>
+            <film type="hdrfilm"><integer name="width" value="64"/><integer name="height" value="32"/>
+                <rfilter type="box"/></film>
+        </sensor>
+        <shape type="rectangle">
+            <transform name="to_world">
+                <scale value="0.02"/>
+                <rotate y="1" angle="180"/>
+                <translate x="0.96875" y="0.21875" z="2"/>
+            </transform>
+            <emitter type="area"><rgb name="radiance" value="1"/></emitter>
+        </shape>
+    </scene>"#;
+    let scene = Scene::build(mitsuba::load_str(xml, Path::new("marker.xml")).unwrap()).unwrap();
+    let image = render_with_threads(&scene, "eyelight", 2, 64);
+    let lit: Vec<(u32, u32)> = (0..image.height)
+        .flat_map(|y| (0..image.width).map(move |x| (x, y)))
+        .filter(|&(x, y)| !image.get(x, y).is_black())
+        .collect();
+    assert_eq!(lit, vec![(16, 12)]);
+}
+
+fn mltbench(args: &[&str], dir: &Path) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_mltbench"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn cli_renders_exr_and_png_and_fails_cleanly_on_bad_input() {
+    let dir = temp_dir("cli");
+    let scene = scenes_dir().join("cbox.xml");
+    let out = dir.join("small.exr");
+    let ok = mltbench(
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "--estimator",
+            "eyelight",
+            "--spp",
+            "1",
+            "-o",
+            "small.exr",
+        ],
+        &dir,
+    );
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    let image = mltbench::io::exr::read_exr(&out).unwrap();
+    assert_eq!((image.width, image.height), (256, 256));
+    assert!(dir.join("small.png").exists());
+
+    // Bad inputs: non-zero exit, a message naming the problem, and no output file.
+    let broken = dir.join("broken.xml");
+    std::fs::write(
+        &broken,
+        "<scene version=\"3.0.0\"><shape type=\"rectangle\">",
+    )
+    .unwrap();
+    let cases: Vec<(Vec<&str>, &str)> = vec![
+        (
+            vec![
+                "render",
+                broken.to_str().unwrap(),
+                "--estimator",
+                "eyelight",
+            ],
+            "broken.xml",
+        ),
+        (
+            vec!["render", "missing.xml", "--estimator", "eyelight"],
+            "missing.xml",
+        ),
+        (
+            vec!["render", scene.to_str().unwrap(), "--estimator", "nope"],
+            "nope",
+        ),
+        (
+            vec![
+                "render",
+                scene.to_str().unwrap(),
+                "--estimator",
+                "eyelight",
+                "--set",
+                "foo=1",
+            ],
+            "foo",
+        ),
+    ];
+    for (args, needle) in cases {
+        let _ = std::fs::remove_file(dir.join("broken.exr"));
+        let _ = std::fs::remove_file(dir.join("missing.exr"));
+        let _ = std::fs::remove_file(dir.join("cbox.exr"));
+        let run = mltbench(&args, &dir);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert!(!run.status.success(), "{args:?} succeeded");
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+        for f in ["broken.exr", "missing.exr", "cbox.exr"] {
+            assert!(!dir.join(f).exists(), "{args:?} wrote {f}");
+        }
+    }
+}
