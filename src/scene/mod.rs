@@ -1,5 +1,6 @@
 //! Scenes: the description read from a file, and the built, renderable `Scene`.
 
+pub mod cie_tables;
 pub mod description;
 pub mod mitsuba;
 pub mod obj;
