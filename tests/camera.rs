@@ -344,3 +344,173 @@ fn raster_in_pixel_never_rounds_into_the_next_pixel() {
     // Without the clamp, 1023 + (1 − 2⁻²⁴) rounds to 1024 in f32.
     assert_eq!(1023.0f32 + just_below_one, 1024.0);
 }
+
+/// Rays recorded from Mitsuba 3.9.1 (`scalar_rgb`): for each sensor, `sensor.sample_ray(0,
+/// 0.5, (x / W, y / H), (0.5, 0.5))` with near_clip 0.05, far_clip 500 and a box-filtered
+/// hdrfilm, printing `ray.o`, `ray.d` and `ray.maxt`. The sensors are
+/// (fov, fov_axis, W, H, lookat origin, target, up).
+#[test]
+#[allow(clippy::excessive_precision)] // the digits Mitsuba printed
+fn matches_rays_recorded_from_mitsuba_3() {
+    type Case = (f32, FovAxis, u32, u32, [f32; 3], [f32; 3], [f32; 3]);
+    let cases: [Case; 5] = [
+        (
+            90.0,
+            FovAxis::X,
+            200,
+            100,
+            [0.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0],
+            [0.0, 1.0, 0.0],
+        ),
+        (
+            45.0,
+            FovAxis::Y,
+            64,
+            48,
+            [0.0, 1.0, -4.0],
+            [0.0, 0.5, 0.0],
+            [0.0, 1.0, 0.0],
+        ),
+        (
+            60.0,
+            FovAxis::Diagonal,
+            37,
+            91,
+            [3.0, -2.0, 5.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ),
+        (
+            30.0,
+            FovAxis::Smaller,
+            200,
+            100,
+            [1.0, 2.0, 3.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ),
+        (
+            70.0,
+            FovAxis::Larger,
+            100,
+            200,
+            [1.0, 2.0, 3.0],
+            [-1.0, 0.0, 0.0],
+            [0.3, 1.0, 0.0],
+        ),
+    ];
+    // (case, raster x, raster y, o, d, maxt)
+    type Record = (usize, f32, f32, [f32; 3], [f32; 3], f32);
+    let records: [Record; 10] = [
+        (
+            0,
+            10.25,
+            40.5,
+            [0.04487501, 0.004750004, 0.05],
+            [0.666273, 0.07052475, 0.74236536],
+            673.4555,
+        ),
+        (
+            0,
+            198.5,
+            99.75,
+            [-0.0492500, -0.024875, 0.05],
+            [-0.66142672, -0.33407086, 0.67149925],
+            744.52795,
+        ),
+        (
+            1,
+            10.25,
+            40.5,
+            [0.01876905, 0.97966963, -3.95215225],
+            [0.339575, -0.36782286, 0.8656761],
+            552.66656,
+        ),
+        (
+            1,
+            62.5,
+            47.75,
+            [-0.02631981, 0.97346157, -3.95292830],
+            [-0.43788731, -0.44152412, 0.78314179],
+            601.00354,
+        ),
+        (
+            2,
+            10.25,
+            40.5,
+            [2.97365904, -1.9745121, 4.96552277],
+            [-0.52346247, 0.50651109, -0.68515223],
+            503.15402,
+        ),
+        (
+            2,
+            35.5,
+            90.75,
+            [2.97943282, -2.00077343, 4.94630194],
+            [-0.35764265, -0.01345027, -0.93376172],
+            575.0166,
+        ),
+        (
+            3,
+            10.25,
+            40.5,
+            [0.99144161, 1.95743191, 2.96536589],
+            [-0.15409161, -0.76642483, -0.6235773],
+            555.3549,
+        ),
+        (
+            3,
+            0.0,
+            0.0,
+            [0.98780036, 1.94990659, 2.97281027],
+            [-0.20930019, -0.85941523, -0.46647492],
+            582.81897,
+        ),
+        (
+            4,
+            10.25,
+            40.5,
+            [0.96342981, 1.99677455, 2.95781207],
+            [-0.65391397, -0.05767417, -0.75436747],
+            559.19452,
+        ),
+        (
+            4,
+            98.5,
+            199.75,
+            [0.99084145, 1.94215941, 2.97594762],
+            [-0.14466625, -0.91363508, -0.37992463],
+            633.01855,
+        ),
+    ];
+    for (case, x, y, o, d, maxt) in records {
+        let (fov, axis, w, h, origin, target, up) = cases[case];
+        let mut s = sensor(
+            lookat(Vec3::from(origin), Vec3::from(target), Vec3::from(up)),
+            fov,
+            axis,
+            w,
+            h,
+        );
+        s.near_clip = 0.05;
+        s.far_clip = 500.0;
+        let ray = Camera::new(&s).generate_ray(Vec2::new(x, y));
+        let what = format!("case {case} raster ({x}, {y})");
+        assert!(
+            (ray.d - Vec3::from(d)).length() < 2e-6,
+            "{what}: d {} vs {d:?}",
+            ray.d
+        );
+        assert!(
+            (ray.o - Vec3::from(o)).length() < 2e-6,
+            "{what}: o {} vs {o:?}",
+            ray.o
+        );
+        assert!(
+            (ray.t_max / maxt - 1.0).abs() < 1e-5,
+            "{what}: t_max {} vs {maxt}",
+            ray.t_max
+        );
+    }
+}
