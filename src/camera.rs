@@ -1,31 +1,272 @@
 //! Mitsuba 3's `perspective` sensor: a pinhole camera looking down +z in camera space,
 //! +y up, pixel (0, 0) at the top left of the image.
+//!
+//! The model, as Mitsuba 3 defines it (its `perspective_projection`): a camera-space point
+//! (x, y, z) with z > 0 lands at the normalised image position
+//!
+//! ```text
+//! u = 1/2 − x / (2 z tan(fov_x / 2))            (u = 0 left edge, 1 right edge)
+//! v = 1/2 − aspect · y / (2 z tan(fov_x / 2))   (v = 0 top edge, 1 bottom edge)
+//! ```
+//!
+//! with aspect = width / height and raster position (u · width, v · height). So camera +y is
+//! image up and camera +x is image LEFT: the frame (x, y, z) is right-handed, and a viewer
+//! looking down +z with +y up has +x on the left. A `lookat` transform has the columns
+//! (left, up, dir, origin) with left = up × dir, so it maps camera +x to the image's left
+//! in world space: the image is never mirrored.
+//!
+//! Rays start on the near plane (Mitsuba 3 moves the origin to the near plane and shortens
+//! `maxt` accordingly); `Ray::t_max` ends them on the far plane.
+//!
+//! Light tracing: `importance` (We) and `pdf_direction` are the pinhole's sensor response and
+//! the solid-angle density of `generate_ray` at uniformly sampled raster positions; `connect`
+//! is the camera end of a light-tracing connection. A light path's contribution splatted
+//! with `Film::splat` needs the splat scale width · height / (number of light paths) to give
+//! per-pixel values in the same units as the camera-side estimates.
+//!
+//! Not here yet: the thin-lens camera (`thinlens`, depth of field).
 
 use glam::{Vec2, Vec3};
 
 use crate::geometry::Ray;
-use crate::scene::SensorDesc;
+use crate::scene::{FovAxis, SensorDesc};
 
-pub struct Camera {}
+/// A pinhole camera (`<sensor type="perspective">`).
+#[derive(Clone, Debug)]
+pub struct Camera {
+    to_world: crate::math::Transform,
+    width: u32,
+    height: u32,
+    /// tan(fov_x / 2): the half-width of the image on the camera-space plane z = 1.
+    tan_half_x: f32,
+    /// width / height.
+    aspect: f32,
+    near_clip: f32,
+    far_clip: f32,
+    /// Area of the image on the camera-space plane z = 1: (2 tan(fov_x / 2))² / aspect.
+    plane_area: f32,
+    /// The pinhole in world space.
+    position: Vec3,
+    /// The viewing direction (camera +z) in world space, unit length.
+    forward: Vec3,
+}
+
+/// The camera end of a connection from a world point (light tracing, BDPT t = 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraConnection {
+    /// Where the point lands on the film.
+    pub raster: Vec2,
+    /// The pinhole in world space.
+    pub camera_position: Vec3,
+    /// Unit direction from the point towards the pinhole.
+    pub direction_to_camera: Vec3,
+    /// Distance from the point to the pinhole.
+    pub distance: f32,
+    /// We(ω) · cos θ_camera / distance²  =  1 / (A cos³θ · distance²), with A the image
+    /// area on the plane z = 1. Multiply by the path throughput, the BSDF at the point and
+    /// the cosine there to get the connection's contribution (Veach 1997, §10.2).
+    pub importance: f32,
+}
+
+/// The horizontal field of view in degrees that Mitsuba 3 derives from `fov` along
+/// `fov_axis` on a film of aspect ratio `aspect` = width / height.
+pub fn horizontal_fov_degrees(fov_degrees: f64, fov_axis: FovAxis, aspect: f64) -> f64 {
+    let half = (0.5 * fov_degrees).to_radians();
+    let axis = match fov_axis {
+        FovAxis::Smaller if aspect > 1.0 => FovAxis::Y,
+        FovAxis::Smaller => FovAxis::X,
+        FovAxis::Larger if aspect > 1.0 => FovAxis::X,
+        FovAxis::Larger => FovAxis::Y,
+        other => other,
+    };
+    let tan_half_x = match axis {
+        FovAxis::Y => half.tan() * aspect,
+        // The diagonal's half-length on z = 1 is tan(fov/2); the width follows from the
+        // aspect ratio: w² (1 + 1/aspect²) = diagonal².
+        FovAxis::Diagonal => half.tan() / (1.0 + 1.0 / (aspect * aspect)).sqrt(),
+        _ => half.tan(),
+    };
+    (2.0 * tan_half_x.atan()).to_degrees()
+}
 
 impl Camera {
+    /// The camera of `sensor`. The scene loader has already checked what Mitsuba rejects:
+    /// 0 < fov < 180 (after conversion to the horizontal axis), 0 < near_clip < far_clip and
+    /// a `to_world` without scaling. Directions are renormalised anyway, so a `to_world`
+    /// that is orthonormal up to rounding is harmless.
     pub fn new(sensor: &SensorDesc) -> Camera {
-        let _ = sensor;
-        todo!("camera")
+        let width = sensor.film.width.max(1);
+        let height = sensor.film.height.max(1);
+        let aspect = width as f64 / height as f64;
+        let fov_x = horizontal_fov_degrees(sensor.fov_degrees as f64, sensor.fov_axis, aspect);
+        let tan_half_x = (0.5 * fov_x).to_radians().tan();
+        let plane_area = (2.0 * tan_half_x) * (2.0 * tan_half_x) / aspect;
+        let to_world = sensor.to_world;
+        Camera {
+            to_world,
+            width,
+            height,
+            tan_half_x: tan_half_x as f32,
+            aspect: aspect as f32,
+            near_clip: sensor.near_clip,
+            far_clip: sensor.far_clip,
+            plane_area: plane_area as f32,
+            position: to_world.point(Vec3::ZERO),
+            forward: to_world.vector(Vec3::Z).normalize(),
+        }
+    }
+
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// The pinhole in world space.
+    pub fn position(&self) -> Vec3 {
+        self.position
+    }
+
+    /// The viewing direction (camera +z) in world space.
+    pub fn forward(&self) -> Vec3 {
+        self.forward
+    }
+
+    /// tan(fov_x / 2): the half-width of the image on the camera-space plane z = 1.
+    pub fn tan_half_fov_x(&self) -> f32 {
+        self.tan_half_x
+    }
+
+    /// The area A of the image on the camera-space plane z = 1.
+    pub fn image_plane_area(&self) -> f32 {
+        self.plane_area
+    }
+
+    /// The camera-space direction (not normalised, z = 1) through raster position `raster`.
+    fn camera_direction(&self, raster: Vec2) -> Vec3 {
+        let u = raster.x / self.width as f32;
+        let v = raster.y / self.height as f32;
+        Vec3::new(
+            (1.0 - 2.0 * u) * self.tan_half_x,
+            (1.0 - 2.0 * v) * self.tan_half_x / self.aspect,
+            1.0,
+        )
     }
 
     /// The primary ray through raster position `raster` (continuous pixel coordinates:
     /// x in [0, width), y in [0, height), (0, 0) = top-left corner of the top-left pixel).
-    /// Its direction is unit length and it starts at the near clip plane.
+    /// Its direction is unit length and it starts at the near clip plane; `t_max` ends it on
+    /// the far clip plane (both planes are z = const in camera space, as in Mitsuba 3).
     pub fn generate_ray(&self, raster: Vec2) -> Ray {
-        let _ = raster;
-        todo!("camera")
+        let d_camera = self.camera_direction(raster).normalize();
+        let d = self.to_world.vector(d_camera).normalize();
+        let inv_z = 1.0 / d_camera.z;
+        let near_t = self.near_clip * inv_z;
+        let far_t = self.far_clip * inv_z;
+        Ray {
+            o: self.position + d * near_t,
+            d,
+            t_max: far_t - near_t,
+        }
     }
 
     /// The raster position a world point projects to, or None when it is behind the
-    /// camera, outside the image or outside the clip range.
+    /// camera, outside the image or outside the clip range. As in Mitsuba 3 the image
+    /// bounds are inclusive: the result lies in [0, width] × [0, height].
     pub fn project(&self, p: Vec3) -> Option<Vec2> {
-        let _ = p;
-        todo!("camera")
+        let q = self.to_world.inverse.transform_point3(p);
+        // Negated comparisons also reject NaN.
+        if !(q.z >= self.near_clip && q.z <= self.far_clip) {
+            return None;
+        }
+        let s = 0.5 / (q.z * self.tan_half_x);
+        let u = 0.5 - q.x * s;
+        let v = 0.5 - self.aspect * q.y * s;
+        if !((0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v)) {
+            return None;
+        }
+        Some(Vec2::new(u * self.width as f32, v * self.height as f32))
     }
+
+    /// The pinhole's importance We(ω) for a unit world-space direction ω leaving the camera:
+    /// 1 / (A cos⁴θ) inside the image, 0 outside (pbrt-v3 §16.1.1 with lens area 1;
+    /// Mitsuba 3's `importance` returns this times cos θ).
+    pub fn importance(&self, direction: Vec3) -> f32 {
+        match self.plane_cos_theta(direction) {
+            Some(cos) => 1.0 / (self.plane_area * cos * cos * cos * cos),
+            None => 0.0,
+        }
+    }
+
+    /// The solid-angle density of the direction of `generate_ray` when the raster position
+    /// is uniform over the whole image: 1 / (A cos³θ) inside the image, 0 outside.
+    pub fn pdf_direction(&self, direction: Vec3) -> f32 {
+        match self.plane_cos_theta(direction) {
+            Some(cos) => 1.0 / (self.plane_area * cos * cos * cos),
+            None => 0.0,
+        }
+    }
+
+    /// cos θ between `direction` and the viewing axis, when the direction passes through
+    /// the image (bounds inclusive, as in Mitsuba 3).
+    fn plane_cos_theta(&self, direction: Vec3) -> Option<f32> {
+        let d = self
+            .to_world
+            .inverse
+            .transform_vector3(direction)
+            .normalize();
+        if d.z.is_nan() || d.z <= 0.0 {
+            return None;
+        }
+        let x = d.x / d.z;
+        let y = d.y / d.z;
+        let half_h = self.tan_half_x / self.aspect;
+        (x.abs() <= self.tan_half_x && y.abs() <= half_h).then_some(d.z)
+    }
+
+    /// The camera end of a connection from world point `p`: None when `p` is outside the
+    /// image or the clip range. Visibility is the caller's business.
+    pub fn connect(&self, p: Vec3) -> Option<CameraConnection> {
+        let raster = self.project(p)?;
+        let to_camera = self.position - p;
+        let distance = to_camera.length();
+        if distance.is_nan() || distance <= 0.0 {
+            return None;
+        }
+        let direction_to_camera = to_camera / distance;
+        let d = self
+            .to_world
+            .inverse
+            .transform_vector3(-direction_to_camera)
+            .normalize();
+        let cos = d.z;
+        if cos.is_nan() || cos <= 0.0 {
+            return None;
+        }
+        let importance = 1.0 / (self.plane_area * cos * cos * cos * distance * distance);
+        Some(CameraConnection {
+            raster,
+            camera_position: self.position,
+            direction_to_camera,
+            distance,
+            importance,
+        })
+    }
+}
+
+/// A raster position inside pixel (x, y) at offset `u` ∈ [0, 1)², guaranteed to round
+/// down to that pixel: in f32, x + u can round up to x + 1 when u is just below 1.
+pub fn raster_in_pixel(x: u32, y: u32, u: Vec2) -> Vec2 {
+    fn inside(i: u32, t: f32) -> f32 {
+        let lo = i as f32;
+        let p = lo + t;
+        if p < lo + 1.0 {
+            p
+        } else {
+            (lo + 1.0).next_down()
+        }
+    }
+    Vec2::new(inside(x, u.x), inside(y, u.y))
 }
