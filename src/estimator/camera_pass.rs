@@ -6,9 +6,10 @@
 
 use rayon::prelude::*;
 
-use crate::film::{Film, FilmTile, PixelRect};
+use crate::camera::raster_in_pixel;
+use crate::film::{Film, FilmTile};
 use crate::geometry::Ray;
-use crate::math::{Rgb, Vec2};
+use crate::math::Rgb;
 use crate::sampler::{IndependentSampler, Sampler};
 use crate::scene::Scene;
 
@@ -29,22 +30,6 @@ pub trait CameraSampleFn: Sync {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut IndependentSampler) -> (Rgb, u64);
 }
 
-/// The tiles that cover a `width` × `height` image, in scanline order.
-pub fn tiles(width: u32, height: u32) -> Vec<PixelRect> {
-    let mut rects = Vec::new();
-    for y0 in (0..height).step_by(TILE_SIZE as usize) {
-        for x0 in (0..width).step_by(TILE_SIZE as usize) {
-            rects.push(PixelRect {
-                x0,
-                y0,
-                x1: (x0 + TILE_SIZE).min(width),
-                y1: (y0 + TILE_SIZE).min(height),
-            });
-        }
-    }
-    rects
-}
-
 /// Takes sample number `pass_index` of every pixel and adds it to `film`.
 /// Samples that are NaN, infinite or negative are dropped and counted.
 pub fn camera_pass(
@@ -54,7 +39,7 @@ pub fn camera_pass(
     pass_index: u32,
     estimate: &impl CameraSampleFn,
 ) -> PassCounts {
-    let rects = tiles(scene.width(), scene.height());
+    let rects = film.tiles(TILE_SIZE);
     let finished: Vec<(FilmTile, PassCounts)> = rects
         .par_iter()
         .map(|&rect| {
@@ -64,7 +49,7 @@ pub fn camera_pass(
             for y in rect.y0..rect.y1 {
                 for x in rect.x0..rect.x1 {
                     sampler.start_pixel_sample((x, y), pass_index as u64);
-                    let raster = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+                    let raster = raster_in_pixel(x, y, sampler.next_2d());
                     let ray = scene.camera.generate_ray(raster);
                     let (value, rays) = estimate.radiance(scene, &ray, &mut sampler);
                     counts.samples += 1;
