@@ -1690,3 +1690,28 @@ fn singular_or_bad_transforms_are_errors() {
         assert!(message.contains(needle), "{op}: {message}");
     }
 }
+
+#[test]
+fn circular_references_and_deep_nesting_are_errors_not_crashes() {
+    let (message, file) = load_err(
+        "cycle_bsdf",
+        &scene(
+            "<shape type=\"sphere\"><ref id=\"a\"/></shape>\n<bsdf type=\"twosided\" id=\"a\"><ref id=\"a\"/></bsdf>",
+        ),
+    );
+    assert_names(&message, &file, 3);
+    assert!(message.contains("circular"), "{message}");
+    let (message, _) = load_err(
+        "cycle_integrator",
+        &with_sphere("<integrator type=\"moment\" id=\"m\"><ref id=\"m\"/></integrator>"),
+    );
+    assert!(message.contains("circular"), "{message}");
+    // 10 000 nested elements.
+    let deep = format!(
+        "{}{}",
+        "<bsdf type=\"twosided\">".repeat(10_000),
+        "</bsdf>".repeat(10_000)
+    );
+    let (message, _) = load_err("deep", &with_sphere(&deep));
+    assert!(message.contains("nested deeper"), "{message}");
+}

@@ -55,7 +55,7 @@ impl Builder<'_> {
         if let Some(desc) = self.parsed_bsdfs.get(&elem) {
             return Ok(desc.clone());
         }
-        let desc = self.parse_bsdf(elem)?;
+        let desc = self.guarded(elem, |b| b.parse_bsdf(elem))?;
         self.parsed_bsdfs.insert(elem, desc.clone());
         Ok(desc)
     }

@@ -19,6 +19,10 @@ const PATH_LIKE: &[&str] = &[
 
 impl Builder<'_> {
     pub(super) fn parse_integrator(&mut self, elem: ElemId) -> Result<IntegratorDesc> {
+        self.guarded(elem, |b| b.parse_integrator_unguarded(elem))
+    }
+
+    fn parse_integrator_unguarded(&mut self, elem: ElemId) -> Result<IntegratorDesc> {
         let tree = self.tree;
         let kind = tree.type_of(elem);
         let props = Props::collect(tree, elem)?;

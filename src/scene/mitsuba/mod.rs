@@ -57,6 +57,8 @@ pub(super) struct Builder<'a> {
     attached_emitters: HashMap<ElemId, usize>,
     /// The (only) environment emitter.
     environment: Option<ElemId>,
+    /// Objects being parsed right now: a reference back to one of them is a cycle.
+    in_progress: HashSet<ElemId>,
 }
 
 impl<'a> Builder<'a> {
@@ -74,7 +76,25 @@ impl<'a> Builder<'a> {
             default_bsdf: None,
             attached_emitters: HashMap::new(),
             environment: None,
+            in_progress: HashSet::new(),
         }
+    }
+
+    /// Runs `parse` for object `elem`, failing instead of recursing forever when the object
+    /// (through references) contains itself.
+    fn guarded<T>(
+        &mut self,
+        elem: ElemId,
+        parse: impl FnOnce(&mut Self) -> Result<T>,
+    ) -> Result<T> {
+        if !self.in_progress.insert(elem) {
+            return Err(self
+                .tree
+                .error(elem, "this object contains itself (circular reference)"));
+        }
+        let result = parse(self);
+        self.in_progress.remove(&elem);
+        result
     }
 
     fn build(&mut self) -> Result<()> {

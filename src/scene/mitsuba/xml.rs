@@ -13,6 +13,9 @@ pub(super) type FileId = usize;
 
 /// Nested `<include>` depth limit (Mitsuba uses the same order of magnitude).
 const MAX_INCLUDE_DEPTH: usize = 15;
+/// Element nesting limit: real scenes stay far below it, and it keeps the recursive
+/// expansion from exhausting the stack on a hostile file.
+const MAX_ELEMENT_DEPTH: usize = 64;
 
 /// One XML element that survived expansion (objects, properties, transform operations, refs).
 #[derive(Debug)]
@@ -218,10 +221,10 @@ pub(super) fn read_text(path: &Path) -> Result<String> {
             "contains NUL bytes: this is not an XML text file",
         ));
     }
-    match String::from_utf8(bytes.clone()) {
-        Ok(text) => Ok(text),
+    match std::str::from_utf8(&bytes) {
+        Ok(_) => Ok(String::from_utf8(bytes).unwrap_or_default()),
         Err(e) => {
-            let offset = e.utf8_error().valid_up_to();
+            let offset = e.valid_up_to();
             Err(Error::input(
                 Location {
                     file: path.to_path_buf(),
@@ -258,6 +261,7 @@ pub(super) fn parse_scene(text: &str, path: &Path) -> Result<Tree> {
         },
         defaults: Vec::new(),
         include_stack: vec![path.to_path_buf()],
+        depth: 0,
     };
     let doc = parse_xml(text, path)?;
     let root = doc.root_element();
@@ -367,6 +371,8 @@ struct Reader {
     /// `<default>` parameters in declaration order (the first declaration of a name wins).
     defaults: Vec<(String, String)>,
     include_stack: Vec<PathBuf>,
+    /// Current element nesting depth (includes count as the elements they hold).
+    depth: usize,
 }
 
 impl Reader {
@@ -465,6 +471,12 @@ impl Reader {
         let Some(kind) = kind_of(&tag) else {
             return Err(Error::input(location(), format!("unknown element <{tag}>")));
         };
+        if self.depth >= MAX_ELEMENT_DEPTH {
+            return Err(Error::input(
+                location(),
+                format!("elements nested deeper than {MAX_ELEMENT_DEPTH} levels"),
+            ));
+        }
         check_attributes(&attrs, &tag, kind, location)?;
         check_placement(kind, &tag, parent_kind, location)?;
         let attr = |name: &str| {
@@ -547,7 +559,8 @@ impl Reader {
                     }
                     self.tree.ids.insert(id, elem);
                 }
-                match kind {
+                self.depth += 1;
+                let result = match kind {
                     Kind::Object | Kind::Transform => {
                         self.expand_children(doc, node, file, elem, kind)
                     }
@@ -565,7 +578,9 @@ impl Reader {
                         }
                         self.expand_children(doc, node, file, elem, kind)
                     }
-                }
+                };
+                self.depth -= 1;
+                result
             }
         }
     }
