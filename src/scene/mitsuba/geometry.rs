@@ -168,17 +168,21 @@ pub(super) fn place_mesh(
     let skipped = before - mesh.indices.len();
 
     if !placement.face_normals {
-        let smooth = smooth_normals(&mesh);
-        match &mut mesh.normals {
-            None => mesh.normals = Some(smooth),
+        let unusable = |n: &Vec3| *n == Vec3::ZERO || !n.is_finite();
+        match &mesh.normals {
+            None => mesh.normals = Some(smooth_normals(&mesh)),
             // Keep the file's normals; only replace ones that did not survive the transform.
-            Some(normals) => {
-                for (n, s) in normals.iter_mut().zip(smooth) {
-                    if *n == Vec3::ZERO || !n.is_finite() {
-                        *n = s;
+            Some(normals) if normals.iter().any(unusable) => {
+                let smooth = smooth_normals(&mesh);
+                if let Some(normals) = &mut mesh.normals {
+                    for (n, s) in normals.iter_mut().zip(smooth) {
+                        if unusable(n) {
+                            *n = s;
+                        }
                     }
                 }
             }
+            Some(_) => {}
         }
     }
 
