@@ -1,0 +1,439 @@
+//! `<bsdf>` elements with Mitsuba 3's parameter names and defaults.
+//!
+//! Defaults (checked against Mitsuba 3's plugin sources):
+//! - `diffuse`: reflectance 0.5.
+//! - `conductor`, `roughconductor`: `material` "none" (a perfect mirror, no Fresnel term);
+//!   given `eta` and/or `k`, the missing one defaults to eta 0 / k 1; specular_reflectance 1.
+//! - rough models: `distribution` beckmann, `alpha` 0.1 (or `alpha_u` + `alpha_v`, both
+//!   required), `sample_visible` true; α = 0 is raised to 10⁻⁴ with a warning, as Mitsuba does.
+//! - `dielectric`, `thindielectric`, `roughdielectric`: int_ior bk7 (1.5046), ext_ior air
+//!   (1.000277), specular_reflectance and specular_transmittance 1.
+//! - `plastic`, `roughplastic`: int_ior polypropylene (1.49), ext_ior air, diffuse_reflectance
+//!   0.5, specular_reflectance 1, nonlinear false; `roughplastic` is isotropic only.
+//! - `twosided`: one nested BSDF for both sides or two (front, back); none may transmit.
+//! - mltbench extensions, with the defaults of Mitsuba 0.6's plugins of the same names:
+//!   `phong` and `blinn` exponent 30, `ward` alpha 0.1; diffuse_reflectance 0.5,
+//!   specular_reflectance 0.2.
+
+use super::Builder;
+use super::values::{Props, Value};
+use super::xml::ElemId;
+use crate::error::Result;
+use crate::math::Rgb;
+use crate::scene::spectra::{named_conductor, named_ior};
+use crate::scene::{BsdfDesc, IorPair, MicrofacetKind, Roughness};
+
+/// Named IORs used as defaults (the values of Mitsuba's IOR table).
+const IOR_BK7: f32 = 1.5046;
+const IOR_AIR: f32 = 1.000277;
+const IOR_POLYPROPYLENE: f32 = 1.49;
+/// Smallest microfacet roughness Mitsuba accepts.
+const MIN_ALPHA: f32 = 1e-4;
+
+/// Mitsuba BSDF plugins mltbench does not implement (a clearer message than "unknown").
+const UNSUPPORTED: &[&str] = &[
+    "principled",
+    "principledthin",
+    "hair",
+    "measured",
+    "measured_polarized",
+    "blendbsdf",
+    "mask",
+    "bumpmap",
+    "normalmap",
+    "polarizer",
+    "retarder",
+    "circular",
+    "pplastic",
+    "roughcoating",
+    "coating",
+];
+
+impl Builder<'_> {
+    /// The BSDF written at `elem`, parsed once however often it is referenced.
+    pub(super) fn bsdf_desc(&mut self, elem: ElemId) -> Result<BsdfDesc> {
+        if let Some(desc) = self.parsed_bsdfs.get(&elem) {
+            return Ok(desc.clone());
+        }
+        let desc = self.guarded(elem, |b| b.parse_bsdf(elem))?;
+        self.parsed_bsdfs.insert(elem, desc.clone());
+        Ok(desc)
+    }
+
+    /// Index into `SceneDescription::bsdfs` of the BSDF at `elem` (shared by every shape
+    /// that references it).
+    pub(super) fn bsdf_index(&mut self, elem: ElemId) -> Result<usize> {
+        if let Some(&index) = self.bsdf_indices.get(&elem) {
+            return Ok(index);
+        }
+        let desc = self.bsdf_desc(elem)?;
+        let index = self.desc.bsdfs.len();
+        self.desc.bsdfs.push(desc);
+        self.bsdf_indices.insert(elem, index);
+        Ok(index)
+    }
+
+    /// Mitsuba's BSDF for shapes that name none: diffuse with reflectance 0.5.
+    pub(super) fn default_bsdf_index(&mut self) -> usize {
+        *self.default_bsdf.get_or_insert_with(|| {
+            self.desc.bsdfs.push(BsdfDesc::Diffuse {
+                reflectance: Rgb::splat(0.5),
+            });
+            self.desc.bsdfs.len() - 1
+        })
+    }
+
+    fn parse_bsdf(&mut self, elem: ElemId) -> Result<BsdfDesc> {
+        let tree = self.tree;
+        let kind = tree.type_of(elem);
+        let props = Props::collect(tree, elem)?;
+        let desc = match kind {
+            "diffuse" => BsdfDesc::Diffuse {
+                reflectance: reflectance(&props, "reflectance", 0.5)?,
+            },
+            "conductor" => {
+                let eta_k = conductor_ior(&props)?;
+                let specular_reflectance = reflectance(&props, "specular_reflectance", 1.0)?;
+                BsdfDesc::Conductor {
+                    eta_k,
+                    specular_reflectance,
+                }
+            }
+            "roughconductor" => {
+                let eta_k = conductor_ior(&props)?;
+                let specular_reflectance = reflectance(&props, "specular_reflectance", 1.0)?;
+                let roughness = self.roughness(&props, true)?;
+                BsdfDesc::RoughConductor {
+                    eta_k,
+                    specular_reflectance,
+                    roughness,
+                }
+            }
+            "dielectric" | "thindielectric" | "roughdielectric" => {
+                let ior = ior_pair(&props, IOR_BK7, false)?;
+                let specular_reflectance = reflectance(&props, "specular_reflectance", 1.0)?;
+                let specular_transmittance = reflectance(&props, "specular_transmittance", 1.0)?;
+                match kind {
+                    "dielectric" => BsdfDesc::Dielectric {
+                        ior,
+                        specular_reflectance,
+                        specular_transmittance,
+                    },
+                    "thindielectric" => BsdfDesc::ThinDielectric {
+                        ior,
+                        specular_reflectance,
+                        specular_transmittance,
+                    },
+                    _ => BsdfDesc::RoughDielectric {
+                        ior,
+                        roughness: self.roughness(&props, true)?,
+                        specular_reflectance,
+                        specular_transmittance,
+                    },
+                }
+            }
+            "plastic" | "roughplastic" => {
+                let ior = ior_pair(&props, IOR_POLYPROPYLENE, true)?;
+                let diffuse_reflectance = reflectance(&props, "diffuse_reflectance", 0.5)?;
+                let specular_reflectance = reflectance(&props, "specular_reflectance", 1.0)?;
+                let nonlinear = props.boolean("nonlinear")?.unwrap_or(false);
+                if kind == "plastic" {
+                    BsdfDesc::Plastic {
+                        ior,
+                        diffuse_reflectance,
+                        specular_reflectance,
+                        nonlinear,
+                    }
+                } else {
+                    BsdfDesc::RoughPlastic {
+                        ior,
+                        diffuse_reflectance,
+                        specular_reflectance,
+                        roughness: self.roughness(&props, false)?,
+                        nonlinear,
+                    }
+                }
+            }
+            "twosided" => self.twosided(&props)?,
+            "null" => BsdfDesc::Null,
+            "phong" | "blinn" => {
+                let exponent = props.float("exponent")?.unwrap_or(30.0);
+                if exponent <= 0.0 {
+                    return Err(tree.error(
+                        props.elem_of("exponent"),
+                        format!("exponent must be positive, got {exponent}"),
+                    ));
+                }
+                let diffuse_reflectance = reflectance(&props, "diffuse_reflectance", 0.5)?;
+                let specular_reflectance = reflectance(&props, "specular_reflectance", 0.2)?;
+                if kind == "phong" {
+                    BsdfDesc::Phong {
+                        exponent,
+                        diffuse_reflectance,
+                        specular_reflectance,
+                    }
+                } else {
+                    BsdfDesc::Blinn {
+                        exponent,
+                        diffuse_reflectance,
+                        specular_reflectance,
+                    }
+                }
+            }
+            "ward" => {
+                let (alpha_u, alpha_v) = self.alphas(&props)?;
+                let diffuse_reflectance = reflectance(&props, "diffuse_reflectance", 0.5)?;
+                let specular_reflectance = reflectance(&props, "specular_reflectance", 0.2)?;
+                BsdfDesc::Ward {
+                    alpha_u,
+                    alpha_v,
+                    diffuse_reflectance,
+                    specular_reflectance,
+                }
+            }
+            other if UNSUPPORTED.contains(&other) => {
+                return Err(tree.error(elem, format!("bsdf type \"{other}\" is not supported yet")));
+            }
+            other => return Err(tree.error(elem, format!("unknown bsdf type \"{other}\""))),
+        };
+        props.finish()?;
+        Ok(desc)
+    }
+
+    /// `twosided`: one nested BSDF for both sides, or front and back.
+    fn twosided(&mut self, props: &Props) -> Result<BsdfDesc> {
+        let tree = self.tree;
+        let mut sides = Vec::new();
+        for (i, object) in props.objects().iter().enumerate() {
+            if tree.tag(object.target) != "bsdf" {
+                continue;
+            }
+            props.use_object(i);
+            if sides.len() == 2 {
+                return Err(tree.error(object.via, "twosided takes at most two nested BSDFs"));
+            }
+            let side = self.bsdf_desc(object.target)?;
+            let transmits = matches!(
+                side,
+                BsdfDesc::Dielectric { .. }
+                    | BsdfDesc::ThinDielectric { .. }
+                    | BsdfDesc::RoughDielectric { .. }
+                    | BsdfDesc::Null
+                    | BsdfDesc::TwoSided { .. }
+            );
+            if transmits {
+                return Err(tree.error(
+                    object.via,
+                    "twosided can only hold one-sided reflecting BSDFs (no dielectric, null or \
+                     twosided)",
+                ));
+            }
+            sides.push(side);
+        }
+        match sides.len() {
+            0 => Err(tree.error(props.owner(), "twosided needs a nested <bsdf>")),
+            1 => {
+                let side = Box::new(sides.pop().expect("one side"));
+                Ok(BsdfDesc::TwoSided {
+                    front: side.clone(),
+                    back: side,
+                })
+            }
+            _ => {
+                let back = Box::new(sides.pop().expect("two sides"));
+                let front = Box::new(sides.pop().expect("two sides"));
+                Ok(BsdfDesc::TwoSided { front, back })
+            }
+        }
+    }
+
+    /// `distribution`, `alpha` / `alpha_u` + `alpha_v`, `sample_visible`.
+    fn roughness(&mut self, props: &Props, anisotropic: bool) -> Result<Roughness> {
+        let tree = self.tree;
+        let kind = match props.string("distribution")? {
+            None => MicrofacetKind::Beckmann,
+            Some(name) => match name.to_ascii_lowercase().as_str() {
+                "beckmann" => MicrofacetKind::Beckmann,
+                "ggx" => MicrofacetKind::Ggx,
+                _ => {
+                    return Err(tree.error(
+                        props.elem_of("distribution"),
+                        format!("unknown microfacet distribution \"{name}\" (beckmann or ggx)"),
+                    ));
+                }
+            },
+        };
+        let (alpha_u, alpha_v) = self.alphas(props)?;
+        if !anisotropic && alpha_u != alpha_v {
+            return Err(tree.error(
+                props.owner(),
+                "this BSDF supports only isotropic roughness (alpha_u = alpha_v)",
+            ));
+        }
+        let sample_visible = props.boolean("sample_visible")?.unwrap_or(true);
+        Ok(Roughness {
+            kind,
+            alpha_u,
+            alpha_v,
+            sample_visible,
+        })
+    }
+
+    /// `alpha` (default 0.1) or both `alpha_u` and `alpha_v`.
+    fn alphas(&mut self, props: &Props) -> Result<(f32, f32)> {
+        let tree = self.tree;
+        let has_uv = props.has("alpha_u") || props.has("alpha_v");
+        if has_uv && props.has("alpha") {
+            return Err(tree.error(
+                props.elem_of("alpha"),
+                "give either \"alpha\" or \"alpha_u\" and \"alpha_v\", not both",
+            ));
+        }
+        let (alpha_u, alpha_v) = if has_uv {
+            match (props.float("alpha_u")?, props.float("alpha_v")?) {
+                (Some(u), Some(v)) => (u, v),
+                _ => {
+                    return Err(tree.error(
+                        props.owner(),
+                        "\"alpha_u\" and \"alpha_v\" must be given together",
+                    ));
+                }
+            }
+        } else {
+            let alpha = props.float("alpha")?.unwrap_or(0.1);
+            (alpha, alpha)
+        };
+        let mut clamp = |name: &str, alpha: f32| -> Result<f32> {
+            if alpha < 0.0 {
+                return Err(tree.error(
+                    props.elem_of(name),
+                    format!("roughness must not be negative, got {alpha}"),
+                ));
+            }
+            if alpha < MIN_ALPHA {
+                let w = tree.warning(
+                    props.elem_of(name),
+                    &format!(
+                        "roughness {alpha} raised to {MIN_ALPHA} (as Mitsuba does); use the \
+                         smooth BSDF for a perfectly specular surface"
+                    ),
+                );
+                self.desc.warnings.push(w);
+                return Ok(MIN_ALPHA);
+            }
+            Ok(alpha)
+        };
+        let name_u = if has_uv { "alpha_u" } else { "alpha" };
+        let name_v = if has_uv { "alpha_v" } else { "alpha" };
+        let u = clamp(name_u, alpha_u)?;
+        let v = if !has_uv && alpha_u == alpha_v {
+            u
+        } else {
+            clamp(name_v, alpha_v)?
+        };
+        Ok((u, v))
+    }
+}
+
+/// A reflectance-like colour: finite and not negative.
+fn reflectance(props: &Props, name: &str, default: f32) -> Result<Rgb> {
+    let Some(rgb) = props.color(name)? else {
+        return Ok(Rgb::splat(default));
+    };
+    if !rgb.0.iter().all(|c| *c >= 0.0) {
+        return Err(props_error(
+            props,
+            name,
+            format!("{name} must not be negative, got {rgb:?}"),
+        ));
+    }
+    Ok(rgb)
+}
+
+fn props_error(props: &Props, name: &str, message: String) -> crate::error::Error {
+    props.tree().error(props.elem_of(name), message)
+}
+
+/// `material` (a named metal, or "none" for a perfect mirror) or `eta` / `k`.
+fn conductor_ior(props: &Props) -> Result<Option<(Rgb, Rgb)>> {
+    let material = props.string("material")?;
+    let has_eta_k = props.has("eta") || props.has("k");
+    match material {
+        Some(name) if name != "none" => {
+            if has_eta_k {
+                return Err(props_error(
+                    props,
+                    "material",
+                    "give either \"material\" or \"eta\"/\"k\", not both".into(),
+                ));
+            }
+            named_conductor(name).map(Some).ok_or_else(|| {
+                props_error(
+                    props,
+                    "material",
+                    format!("unknown conductor material \"{name}\""),
+                )
+            })
+        }
+        _ if has_eta_k => {
+            // Mitsuba's defaults when only one is given: eta 0, k 1.
+            let eta = props.color("eta")?.unwrap_or(Rgb::splat(0.0));
+            let k = props.color("k")?.unwrap_or(Rgb::splat(1.0));
+            if !eta.0.iter().chain(k.0.iter()).all(|c| *c >= 0.0) {
+                return Err(props_error(
+                    props,
+                    "eta",
+                    "eta and k must not be negative".into(),
+                ));
+            }
+            Ok(Some((eta, k)))
+        }
+        _ => Ok(None),
+    }
+}
+
+/// `int_ior` / `ext_ior` as numbers or names; plastics need them to differ.
+fn ior_pair(props: &Props, int_default: f32, must_differ: bool) -> Result<IorPair> {
+    let int_ior = ior(props, "int_ior")?.unwrap_or(int_default);
+    let ext_ior = ior(props, "ext_ior")?.unwrap_or(IOR_AIR);
+    if must_differ && int_ior == ext_ior {
+        return Err(props_error(
+            props,
+            "int_ior",
+            format!("int_ior and ext_ior must differ (both {int_ior})"),
+        ));
+    }
+    Ok(IorPair { int_ior, ext_ior })
+}
+
+fn ior(props: &Props, name: &str) -> Result<Option<f32>> {
+    let Some(prop) = props.get(name) else {
+        return Ok(None);
+    };
+    let value = match &prop.value {
+        Value::Float(v) => *v,
+        Value::Integer(v) => *v as f32,
+        Value::Str(text) => named_ior(&text.to_ascii_lowercase()).ok_or_else(|| {
+            props_error(
+                props,
+                name,
+                format!("unknown index of refraction name \"{text}\""),
+            )
+        })?,
+        _ => {
+            return Err(props_error(
+                props,
+                name,
+                format!("{name} must be a <float> or a <string> name such as \"bk7\""),
+            ));
+        }
+    };
+    if value <= 0.0 {
+        return Err(props_error(
+            props,
+            name,
+            format!("{name} must be positive, got {value}"),
+        ));
+    }
+    Ok(Some(value))
+}
