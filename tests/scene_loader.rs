@@ -1287,7 +1287,11 @@ fn point_directional_and_constant_emitters() {
     assert_eq!(
         desc.emitters[2],
         EmitterDesc::Directional {
-            irradiance: Rgb::splat(3.0),
+            // A one-value spectrum in an emitter is equal-energy white in sRGB (Mitsuba 3).
+            irradiance: mltbench::scene::spectra::uniform_spectrum_to_rgb(
+                3.0,
+                mltbench::scene::spectra::SpectrumUse::Emission
+            ),
             direction: -Vec3::Y
         }
     );

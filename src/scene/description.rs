@@ -75,7 +75,7 @@ impl Default for SensorDesc {
     fn default() -> Self {
         SensorDesc {
             to_world: Transform::IDENTITY,
-            fov_degrees: 39.597755, // Mitsuba: 50mm focal length on a 36mm-wide film, along x
+            fov_degrees: 39.597755, // 50 mm on a 36 mm-wide film; the loader always sets its own
             fov_axis: FovAxis::X,
             near_clip: 1e-2,
             far_clip: 1e4,

@@ -11,7 +11,7 @@ use super::transform::parse_transform;
 use super::xml::{ElemId, Tree};
 use crate::error::Result;
 use crate::math::{Rgb, Transform};
-use crate::scene::spectra::{SpectrumUse, spectrum_to_rgb};
+use crate::scene::spectra::{SpectrumUse, spectrum_to_rgb, uniform_spectrum_to_rgb};
 
 /// Splits a list of numbers written "x, y, z" or "x y z".
 pub(super) fn tokens(text: &str) -> Vec<&str> {
@@ -335,30 +335,29 @@ impl<'a> Props<'a> {
         let Some(prop) = self.get(name) else {
             return Ok(None);
         };
+        let usage = if self.tree.tag(self.owner) == "emitter" {
+            SpectrumUse::Emission
+        } else if matches!(name, "eta" | "k" | "int_ior" | "ext_ior") {
+            SpectrumUse::Unbounded
+        } else {
+            SpectrumUse::Reflectance
+        };
         let rgb = match &prop.value {
             Value::Rgb(c) => *c,
             Value::Float(v) => Rgb::splat(*v),
             Value::Integer(v) => Rgb::splat(*v as f32),
-            Value::Spectrum(SpectrumValue::Constant(v)) => Rgb::splat(*v),
-            Value::Spectrum(SpectrumValue::Pairs(pairs)) => {
-                let usage = if self.tree.tag(self.owner) == "emitter" {
-                    SpectrumUse::Emission
-                } else if matches!(name, "eta" | "k" | "int_ior" | "ext_ior") {
-                    SpectrumUse::Unbounded
-                } else {
-                    SpectrumUse::Reflectance
-                };
-                let rgb = spectrum_to_rgb(pairs, usage);
-                if !rgb.0.iter().all(|c| c.is_finite()) {
-                    return Err(self.tree.error(
-                        prop.elem,
-                        format!("spectrum \"{name}\" converts to a non-finite colour"),
-                    ));
-                }
-                rgb
-            }
+            // A one-value spectrum is a constant over wavelength: inside an emitter it is
+            // equal-energy white, which is not (1, 1, 1) in sRGB.
+            Value::Spectrum(SpectrumValue::Constant(v)) => uniform_spectrum_to_rgb(*v, usage),
+            Value::Spectrum(SpectrumValue::Pairs(pairs)) => spectrum_to_rgb(pairs, usage),
             _ => return Err(self.wrong_type(prop, "an <rgb>, <spectrum> or <float>")),
         };
+        if !rgb.0.iter().all(|c| c.is_finite()) {
+            return Err(self.tree.error(
+                prop.elem,
+                format!("\"{name}\" converts to a non-finite colour"),
+            ));
+        }
         Ok(Some(rgb))
     }
 
