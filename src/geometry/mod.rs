@@ -1,9 +1,36 @@
 //! Ray casting: all triangles in one BVH (obvhs), analytic shapes beside it.
+//!
+//! - `bvh.rs`: the compressed 8-wide BVH over every triangle of every mesh, and its
+//!   conservative traversal (closest hit and any hit).
+//! - `triangle.rs`: the watertight ray/triangle test and the hit point's error bound.
+//! - `sphere.rs`, `disk.rs`: analytic shapes, tested one by one in f64.
+//! - `offset.rs`: error bounds and robust origins for rays leaving a surface.
+//! - `procedural.rs`: meshes generated in code for tests and benchmarks.
+//!
+//! Conventions (Mitsuba 3's): the geometric normal `ng` is the front side of the surface:
+//! counter-clockwise winding for triangles (mesh `flip_normals` is already applied by the
+//! loader), outward for spheres, local +z for disks, negated by `flip_normals` for the
+//! analytic shapes. The shading normal `ns` is the normalised barycentric interpolation of
+//! the mesh's vertex normals, kept as interpolated even when it lies on the other side of
+//! `ng` (Mitsuba does not flip it either; BSDFs and the adjoint correction see both), or
+//! `ng` when the mesh has none.
+
+pub mod bvh;
+pub mod disk;
+pub mod offset;
+pub mod procedural;
+pub mod sphere;
+pub mod triangle;
 
 use glam::{Vec2, Vec3};
 
 use crate::math::Frame;
-use crate::scene::ShapeDesc;
+use crate::scene::{ShapeDesc, ShapeGeometry};
+
+use bvh::{TraversalRay, TriangleBvh};
+use disk::Disk;
+use offset::offset_ray_origin;
+use sphere::Sphere;
 
 /// A ray segment: points o + t·d for t in (0, t_max). Origins are already offset off
 /// surfaces by `SurfaceInteraction::spawn_ray*`, so no epsilon is needed at t = 0.
@@ -29,21 +56,30 @@ impl Ray {
     }
 }
 
+/// How much shorter than the full segment a ray aimed at a point stops (relative to the
+/// segment): `spawn_ray_to*` rays have t_max = 1 − SHADOW_EPSILON, so a surface through the
+/// target point itself is not reported as an occluder.
+pub const SHADOW_EPSILON: f32 = 1e-4;
+
 /// What a closest-hit query returns about the surface it hit.
 #[derive(Clone, Copy, Debug)]
 pub struct SurfaceInteraction {
     /// Hit position.
     pub p: Vec3,
-    /// Conservative absolute error bound on each coordinate of `p`.
+    /// Conservative absolute error bound on each coordinate of `p`: the exact surface point
+    /// lies in the box p ± p_error.
     pub p_error: Vec3,
-    /// Ray parameter of the hit.
+    /// Ray parameter of the hit (in units of the query ray's `d`).
     pub t: f32,
     /// Geometric normal (unit), on the shape's front side (after `flip_normals`).
     pub ng: Vec3,
-    /// Shading normal (unit): interpolated vertex normal, or `ng`. Same hemisphere as `ng`.
+    /// Shading normal (unit): the interpolated vertex normal as it is (possibly on the other
+    /// side of `ng`, as in Mitsuba), or `ng` when there are no vertex normals.
     pub ns: Vec3,
-    /// Shading frame around `ns`.
+    /// Shading frame around `ns` (`Frame::from_normal(ns)`).
     pub frame: Frame,
+    /// Mesh uvs interpolated, or the barycentrics (b1, b2) when the mesh has none; Mitsuba's
+    /// spherical (φ/2π, θ/π) on spheres and polar (r, φ/2π) on disks.
     pub uv: Vec2,
     /// Index of the shape in `SceneDescription::shapes`.
     pub shape: u32,
@@ -54,35 +90,384 @@ pub struct SurfaceInteraction {
 impl SurfaceInteraction {
     /// A ray leaving the surface in direction `d`, origin offset to the side `d` points to.
     pub fn spawn_ray(&self, d: Vec3) -> Ray {
-        let _ = d;
-        todo!("geometry")
+        Ray::new(offset_ray_origin(self.p, self.p_error, self.ng, d), d)
     }
 
-    /// A ray from this surface towards point `target`, stopping just short of it.
+    /// A ray from this surface towards point `target`, stopping just short of it:
+    /// d = target − origin, t_max = 1 − SHADOW_EPSILON.
     pub fn spawn_ray_to(&self, target: Vec3) -> Ray {
-        let _ = target;
-        todo!("geometry")
+        let o = offset_ray_origin(self.p, self.p_error, self.ng, target - self.p);
+        Ray {
+            o,
+            d: target - o,
+            t_max: 1.0 - SHADOW_EPSILON,
+        }
+    }
+
+    /// A ray from this surface towards a point on another surface, both ends offset off
+    /// their surfaces (the robust choice for connecting two surface vertices).
+    pub fn spawn_ray_to_interaction(&self, other: &SurfaceInteraction) -> Ray {
+        let o = offset_ray_origin(self.p, self.p_error, self.ng, other.p - self.p);
+        let target = offset_ray_origin(other.p, other.p_error, other.ng, o - other.p);
+        Ray {
+            o,
+            d: target - o,
+            t_max: 1.0 - SHADOW_EPSILON,
+        }
+    }
+}
+
+/// An axis-aligned box.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bounds3 {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Bounds3 {
+    pub const EMPTY: Bounds3 = Bounds3 {
+        min: Vec3::splat(f32::INFINITY),
+        max: Vec3::splat(f32::NEG_INFINITY),
+    };
+
+    pub fn is_empty(&self) -> bool {
+        !(self.min.x <= self.max.x && self.min.y <= self.max.y && self.min.z <= self.max.z)
+    }
+
+    pub fn union(&self, other: &Bounds3) -> Bounds3 {
+        Bounds3 {
+            min: self.min.min(other.min),
+            max: self.max.max(other.max),
+        }
+    }
+
+    pub fn with_point(&self, p: Vec3) -> Bounds3 {
+        Bounds3 {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+
+    pub fn center(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    pub fn diagonal(&self) -> Vec3 {
+        self.max - self.min
+    }
+
+    /// A sphere containing the box: (centre, radius); radius 0 for an empty box.
+    pub fn bounding_sphere(&self) -> (Vec3, f32) {
+        if self.is_empty() {
+            return (Vec3::ZERO, 0.0);
+        }
+        (self.center(), self.diagonal().length() * 0.5)
+    }
+}
+
+/// Per-vertex attributes of a mesh shape, read at hits.
+struct MeshAttributes {
+    indices: Vec<[u32; 3]>,
+    normals: Option<Vec<Vec3>>,
+    uvs: Option<Vec<Vec2>>,
+}
+
+/// The closest hit found by traversal (before computing surface data).
+enum Hit {
+    Triangle {
+        record: u32,
+    },
+    Sphere {
+        index: usize,
+        t: f64,
+    },
+    Disk {
+        index: usize,
+        t: f64,
+        local: [f64; 2],
+    },
+}
+
+/// A ray with unit direction, and what converts its distances back to the caller's units.
+struct NormalizedRay {
+    o: Vec3,
+    d: Vec3,
+    /// |ray.d|: caller's t = distance / len.
+    len: f32,
+    t_max: f32,
+}
+
+impl NormalizedRay {
+    /// None for rays that cannot hit anything (zero or non-finite direction, non-finite
+    /// origin, t_max ≤ 0 or NaN).
+    fn new(ray: &Ray) -> Option<NormalizedRay> {
+        let len = ray.d.length();
+        if !(len > 0.0 && len.is_finite() && ray.o.is_finite() && ray.t_max > 0.0) {
+            return None;
+        }
+        let d = ray.d / len;
+        Some(NormalizedRay {
+            o: ray.o,
+            d,
+            len,
+            t_max: ray.t_max * len,
+        })
     }
 }
 
 /// The acceleration structure over all shapes of a scene.
-pub struct Geometry {}
+pub struct Geometry {
+    bvh: TriangleBvh,
+    /// Indexed by shape; `Some` for meshes.
+    meshes: Vec<Option<MeshAttributes>>,
+    spheres: Vec<Sphere>,
+    disks: Vec<Disk>,
+    bounds: Bounds3,
+    triangle_count: usize,
+    skipped_shapes: usize,
+    skipped_triangles: usize,
+}
 
 impl Geometry {
+    /// Builds the BVH over all mesh triangles and collects the analytic shapes. Triangles
+    /// that cannot be intersected (index out of range, non-finite vertex, zero area) and
+    /// analytic shapes with invalid parameters are skipped (counted, see `skipped()`):
+    /// the scene loader reports such input; here it must simply not break the tracer.
     pub fn build(shapes: &[ShapeDesc]) -> Geometry {
-        let _ = shapes;
-        todo!("geometry")
+        let mut triangles = Vec::new();
+        let mut ids = Vec::new();
+        let mut meshes = Vec::with_capacity(shapes.len());
+        let mut spheres = Vec::new();
+        let mut disks = Vec::new();
+        let mut bounds = Bounds3::EMPTY;
+        let mut skipped_shapes = 0;
+        let mut skipped_triangles = 0;
+        for (si, shape) in shapes.iter().enumerate() {
+            let si = si as u32;
+            match &shape.geometry {
+                ShapeGeometry::Mesh(mesh) => {
+                    let n = mesh.positions.len();
+                    for (pi, idx) in mesh.indices.iter().enumerate() {
+                        if idx.iter().any(|&i| i as usize >= n) {
+                            skipped_triangles += 1;
+                            continue;
+                        }
+                        let v = idx.map(|i| mesh.positions[i as usize]);
+                        let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+                        if !(v.iter().all(|p| p.is_finite()) && ng.is_finite()) {
+                            skipped_triangles += 1;
+                            continue;
+                        }
+                        for p in v {
+                            bounds = bounds.with_point(p);
+                        }
+                        triangles.push(v);
+                        ids.push([si, pi as u32]);
+                    }
+                    meshes.push(Some(MeshAttributes {
+                        indices: mesh.indices.clone(),
+                        normals: mesh.normals.clone().filter(|v| v.len() == n),
+                        uvs: mesh.uvs.clone().filter(|v| v.len() == n),
+                    }));
+                }
+                ShapeGeometry::Sphere { center, radius } => {
+                    meshes.push(None);
+                    let s = Sphere {
+                        center: *center,
+                        radius: *radius,
+                        flip_normals: shape.flip_normals,
+                        shape: si,
+                    };
+                    if s.is_valid() {
+                        let (lo, hi) = s.bounds();
+                        bounds = bounds.with_point(lo).with_point(hi);
+                        spheres.push(s);
+                    } else {
+                        skipped_shapes += 1;
+                    }
+                }
+                ShapeGeometry::Disk { to_world } => {
+                    meshes.push(None);
+                    match Disk::new(to_world, shape.flip_normals, si) {
+                        Some(d) => {
+                            let (lo, hi) = d.bounds();
+                            bounds = bounds.with_point(lo).with_point(hi);
+                            disks.push(d);
+                        }
+                        None => skipped_shapes += 1,
+                    }
+                }
+            }
+        }
+        let triangle_count = triangles.len();
+        let bvh = TriangleBvh::build(&triangles, &ids);
+        Geometry {
+            bvh,
+            meshes,
+            spheres,
+            disks,
+            bounds,
+            triangle_count,
+            skipped_shapes,
+            skipped_triangles,
+        }
+    }
+
+    /// The scene's bounding box (empty when there is nothing to hit).
+    pub fn bounds(&self) -> Bounds3 {
+        self.bounds
+    }
+
+    /// Number of triangles in the BVH.
+    pub fn triangle_count(&self) -> usize {
+        self.triangle_count
+    }
+
+    /// (analytic shapes, triangles) left out by `build` because they cannot be hit.
+    pub fn skipped(&self) -> (usize, usize) {
+        (self.skipped_shapes, self.skipped_triangles)
     }
 
     /// Closest hit along the ray, if any, with t < ray.t_max.
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
-        let _ = ray;
-        todo!("geometry")
+        let r = NormalizedRay::new(ray)?;
+        let mut t_max64 = r.t_max as f64;
+        let mut hit = None;
+        for (index, s) in self.spheres.iter().enumerate() {
+            if let Some(t) = s.intersect(r.o, r.d, t_max64) {
+                t_max64 = t;
+                hit = Some(Hit::Sphere { index, t });
+            }
+        }
+        for (index, d) in self.disks.iter().enumerate() {
+            if let Some((t, local)) = d.intersect(r.o, r.d, t_max64) {
+                t_max64 = t;
+                hit = Some(Hit::Disk { index, t, local });
+            }
+        }
+        let traversal = TraversalRay::new(r.o, r.d);
+        let t_max = if hit.is_some() {
+            t_max64 as f32
+        } else {
+            r.t_max
+        };
+        if let Some((record, _)) = self.bvh.closest(&traversal, t_max) {
+            hit = Some(Hit::Triangle { record });
+        }
+        match hit? {
+            Hit::Triangle { record } => self.triangle_interaction(record, &traversal, r.len),
+            Hit::Sphere { index, t } => {
+                let s = &self.spheres[index];
+                let h = s.hit(r.o, r.d, t);
+                Some(interaction(
+                    h.p,
+                    h.p_error,
+                    (t / r.len as f64) as f32,
+                    h.n,
+                    h.n,
+                    h.uv,
+                    s.shape,
+                    0,
+                ))
+            }
+            Hit::Disk { index, t, local } => {
+                let d = &self.disks[index];
+                let h = d.hit(local);
+                Some(interaction(
+                    h.p,
+                    h.p_error,
+                    (t / r.len as f64) as f32,
+                    h.n,
+                    h.n,
+                    h.uv,
+                    d.shape,
+                    0,
+                ))
+            }
+        }
     }
 
     /// True when anything lies on the ray with t < ray.t_max (any-hit shadow query).
     pub fn occluded(&self, ray: &Ray) -> bool {
-        let _ = ray;
-        todo!("geometry")
+        let Some(r) = NormalizedRay::new(ray) else {
+            return false;
+        };
+        let t_max64 = r.t_max as f64;
+        if self
+            .spheres
+            .iter()
+            .any(|s| s.intersect(r.o, r.d, t_max64).is_some())
+            || self
+                .disks
+                .iter()
+                .any(|d| d.intersect(r.o, r.d, t_max64).is_some())
+        {
+            return true;
+        }
+        self.bvh.any(&TraversalRay::new(r.o, r.d), r.t_max)
+    }
+
+    fn triangle_interaction(
+        &self,
+        record: u32,
+        ray: &TraversalRay,
+        len: f32,
+    ) -> Option<SurfaceInteraction> {
+        let h = self.bvh.hit(record, ray)?;
+        let rec = self.bvh.record(record);
+        let v = [rec.vertex(0), rec.vertex(1), rec.vertex(2)];
+        let b = h.barycentrics();
+        let (p, p_error) = triangle::hit_point(v, b);
+        let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+        let [shape, primitive] = self.bvh.id(record);
+        let mut ns = ng;
+        let mut uv = Vec2::new(b[1], b[2]);
+        if let Some(mesh) = self.meshes[shape as usize].as_ref() {
+            let idx = mesh.indices[primitive as usize].map(|i| i as usize);
+            if let Some(normals) = &mesh.normals {
+                let n = normals[idx[0]] * b[0] + normals[idx[1]] * b[1] + normals[idx[2]] * b[2];
+                let n = n.normalize_or_zero();
+                if n != Vec3::ZERO {
+                    ns = n;
+                }
+            }
+            if let Some(uvs) = &mesh.uvs {
+                uv = uvs[idx[0]] * b[0] + uvs[idx[1]] * b[1] + uvs[idx[2]] * b[2];
+            }
+        }
+        Some(interaction(
+            p,
+            p_error,
+            h.t / len,
+            ng,
+            ns,
+            uv,
+            shape,
+            primitive,
+        ))
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn interaction(
+    p: Vec3,
+    p_error: Vec3,
+    t: f32,
+    ng: Vec3,
+    ns: Vec3,
+    uv: Vec2,
+    shape: u32,
+    primitive: u32,
+) -> SurfaceInteraction {
+    SurfaceInteraction {
+        p,
+        p_error,
+        t,
+        ng,
+        ns,
+        frame: Frame::from_normal(ns),
+        uv,
+        shape,
+        primitive,
     }
 }

@@ -1,0 +1,491 @@
+//! All triangles of a scene in one compressed 8-wide BVH (Ylitie, Karras & Laine,
+//! "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", HPG 2017),
+//! built by obvhs (PLOC + reinsertion, then collapsed to CWBVH).
+//!
+//! The traversal is mltbench's own, so that it can be conservative: obvhs's node test
+//! drops boxes closer than t = 1e-4 and has no rounding slack, which loses hits near ray
+//! origins and lets rays slip past box faces. Here each slab distance is widened by a bound
+//! on its rounding error (and on the builder's quantisation rounding), so a triangle that
+//! the exact ray meets is never culled by a box test; the triangle test is watertight
+//! (`triangle.rs`). Triangle data are stored in the BVH's leaf order: a leaf's triangles
+//! are contiguous and need no index indirection.
+
+use glam::{UVec2, Vec3, Vec3A, uvec2};
+use obvhs::{
+    BvhBuildParams, bvh2::reinsertion::ReinsertionOptimizer, cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh,
+    cwbvh::node::CwBvhNode, ploc::PlocBuilder, triangle::Triangle,
+};
+
+use super::offset::gamma;
+use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord};
+
+/// Build settings: obvhs's `fast_build` preset (measured against the others in the
+/// README's geometry section: best traversal for the build time).
+pub fn build_params() -> BvhBuildParams {
+    BvhBuildParams::fast_build()
+}
+
+/// Depth up to which traversal uses a fixed stack on the machine stack.
+const FIXED_STACK: usize = 64;
+
+/// A ray prepared for traversal: unit direction, reciprocals, octant, triangle constants.
+#[derive(Clone, Copy, Debug)]
+pub struct TraversalRay {
+    pub o: Vec3A,
+    pub d: Vec3A,
+    pub inv_d: Vec3A,
+    /// Byte offsets in a `CwBvhNode` of the near and far child planes along x, y, z.
+    near: [usize; 3],
+    far: [usize; 3],
+    /// Child-order key of the ray's octant, as obvhs's builder expects it.
+    oct_inv4: u32,
+    pub tri: TriangleRay,
+}
+
+impl TraversalRay {
+    /// `d` must be finite and of unit length (up to rounding).
+    pub fn new(o: Vec3, d: Vec3) -> Self {
+        // A zero (or tiny) component would give an infinite reciprocal and NaN slab
+        // distances (0·∞); 1e-18 keeps them finite, and the resulting tilt (≤ 1e-18 per
+        // unit of t) is far below f32 resolution at any scene scale.
+        let clamp = |c: f32| {
+            if c.abs() < 1e-18 {
+                1e-18f32.copysign(c)
+            } else {
+                c
+            }
+        };
+        let dc = Vec3A::new(clamp(d.x), clamp(d.y), clamp(d.z));
+        let offsets = [
+            (
+                std::mem::offset_of!(CwBvhNode, child_min_x),
+                std::mem::offset_of!(CwBvhNode, child_max_x),
+            ),
+            (
+                std::mem::offset_of!(CwBvhNode, child_min_y),
+                std::mem::offset_of!(CwBvhNode, child_max_y),
+            ),
+            (
+                std::mem::offset_of!(CwBvhNode, child_min_z),
+                std::mem::offset_of!(CwBvhNode, child_max_z),
+            ),
+        ];
+        let mut near = [0; 3];
+        let mut far = [0; 3];
+        for k in 0..3 {
+            let (lo, hi) = offsets[k];
+            (near[k], far[k]) = if dc[k] < 0.0 { (hi, lo) } else { (lo, hi) };
+        }
+        let oct_inv4 = (if d.x < 0.0 { 0 } else { 0x0404_0404 })
+            | (if d.y < 0.0 { 0 } else { 0x0202_0202 })
+            | (if d.z < 0.0 { 0 } else { 0x0101_0101 });
+        TraversalRay {
+            o: o.into(),
+            d: d.into(),
+            inv_d: dc.recip(),
+            near,
+            far,
+            oct_inv4,
+            tri: TriangleRay::new(o, d),
+        }
+    }
+}
+
+/// The BVH and the triangles in its leaf order.
+#[derive(Default)]
+pub struct TriangleBvh {
+    nodes: Vec<CwBvhNode>,
+    records: Vec<TriangleRecord>,
+    /// (shape, primitive) of each record.
+    ids: Vec<[u32; 2]>,
+    depth: usize,
+}
+
+impl TriangleBvh {
+    /// `triangles[i]` has vertices `triangles[i]` and identity `ids[i]`.
+    pub fn build(triangles: &[[Vec3; 3]], ids: &[[u32; 2]]) -> TriangleBvh {
+        if triangles.is_empty() {
+            return TriangleBvh::default();
+        }
+        let params = build_params();
+        let aabbs: Vec<obvhs::aabb::Aabb> = triangles
+            .iter()
+            .map(|t| {
+                Triangle {
+                    v0: t[0].into(),
+                    v1: t[1].into(),
+                    v2: t[2].into(),
+                }
+                .aabb()
+            })
+            .collect();
+        let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
+            params.ploc_search_distance,
+            &aabbs,
+            (0..aabbs.len() as u32).collect(),
+            params.sort_precision,
+            params.search_depth_threshold,
+        );
+        drop(aabbs);
+        ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
+        let cwbvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
+        drop(bvh2);
+        let records = cwbvh
+            .primitive_indices
+            .iter()
+            .map(|&i| {
+                let t = &triangles[i as usize];
+                TriangleRecord::new(t[0], t[1], t[2])
+            })
+            .collect();
+        let ids = cwbvh
+            .primitive_indices
+            .iter()
+            .map(|&i| ids[i as usize])
+            .collect();
+        let depth = depth(&cwbvh.nodes, 0);
+        TriangleBvh {
+            nodes: cwbvh.nodes,
+            records,
+            ids,
+            depth,
+        }
+    }
+
+    pub fn record(&self, index: u32) -> &TriangleRecord {
+        &self.records[index as usize]
+    }
+
+    /// (shape, primitive) of record `index`.
+    pub fn id(&self, index: u32) -> [u32; 2] {
+        self.ids[index as usize]
+    }
+
+    pub fn node_count(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Closest triangle with 0 < t < t_max: (record index, t).
+    pub fn closest(&self, ray: &TraversalRay, t_max: f32) -> Option<(u32, f32)> {
+        if self.nodes.is_empty() {
+            return None;
+        }
+        let mut best = None;
+        let mut t_max = t_max;
+        let visit = |id: u32, t_max: &mut f32| {
+            if let Some(h) = triangle::intersect(&self.records[id as usize], &ray.tri, *t_max) {
+                *t_max = h.t;
+                best = Some(id);
+            }
+            false
+        };
+        if self.depth < FIXED_STACK {
+            self.traverse(
+                ray,
+                &mut t_max,
+                &mut FixedStack::<FIXED_STACK>::new(),
+                visit,
+            );
+        } else {
+            self.traverse(
+                ray,
+                &mut t_max,
+                &mut Vec::with_capacity(self.depth + 1),
+                visit,
+            );
+        }
+        best.map(|id| (id, t_max))
+    }
+
+    /// True when some triangle lies at 0 < t < t_max.
+    pub fn any(&self, ray: &TraversalRay, t_max: f32) -> bool {
+        if self.nodes.is_empty() {
+            return false;
+        }
+        let mut t_max = t_max;
+        let visit = |id: u32, t_max: &mut f32| {
+            triangle::intersect(&self.records[id as usize], &ray.tri, *t_max).is_some()
+        };
+        if self.depth < FIXED_STACK {
+            self.traverse(
+                ray,
+                &mut t_max,
+                &mut FixedStack::<FIXED_STACK>::new(),
+                visit,
+            )
+        } else {
+            self.traverse(
+                ray,
+                &mut t_max,
+                &mut Vec::with_capacity(self.depth + 1),
+                visit,
+            )
+        }
+    }
+
+    /// The hit data of record `index` for `ray` (the same test as during traversal).
+    pub fn hit(&self, index: u32, ray: &TraversalRay) -> Option<TriangleHit> {
+        triangle::intersect(&self.records[index as usize], &ray.tri, f32::INFINITY)
+    }
+
+    /// Walks the BVH front to back (Ylitie et al. 2017, Algorithm 1: node groups hold the
+    /// unvisited hit children of a node as a bit mask ordered by the ray octant; triangle
+    /// groups the hit leaf triangles). `visit` tests one triangle, may lower `t_max`, and
+    /// returns true to stop. Returns true when stopped.
+    #[inline(always)]
+    fn traverse<S: TraversalStack>(
+        &self,
+        ray: &TraversalRay,
+        t_max: &mut f32,
+        stack: &mut S,
+        mut visit: impl FnMut(u32, &mut f32) -> bool,
+    ) -> bool {
+        let oct = ray.oct_inv4 & 0xff;
+        // The root alone in a group: child base 0, one hit bit in slot 7 ^ oct's place.
+        let mut node_group = uvec2(0, 0x8000_0000);
+        let mut tri_group = UVec2::ZERO;
+        loop {
+            if node_group.y & 0xff00_0000 != 0 {
+                let hits = node_group.y;
+                let bit = 31 - hits.leading_zeros();
+                node_group.y &= !(1u32 << bit);
+                if node_group.y & 0xff00_0000 != 0 {
+                    stack.push(node_group);
+                }
+                let slot = (bit - 24) ^ oct;
+                let rank = (hits & !(u32::MAX << slot)).count_ones();
+                let node = &self.nodes[(node_group.x + rank) as usize];
+                let hitmask = node_hitmask(node, ray, *t_max);
+                node_group = uvec2(
+                    node.child_base_idx,
+                    (hitmask & 0xff00_0000) | node.imask as u32,
+                );
+                tri_group = uvec2(node.primitive_base_idx, hitmask & 0x00ff_ffff);
+            } else {
+                node_group = UVec2::ZERO;
+            }
+            while tri_group.y != 0 {
+                let bit = tri_group.y.trailing_zeros();
+                tri_group.y &= tri_group.y - 1;
+                if visit(tri_group.x + bit, t_max) {
+                    return true;
+                }
+            }
+            if node_group.y & 0xff00_0000 == 0 {
+                match stack.pop() {
+                    Some(g) => node_group = g,
+                    None => return false,
+                }
+            }
+        }
+    }
+}
+
+/// Depth of the CWBVH below `node` (1 for a node whose children are all leaves).
+fn depth(nodes: &[CwBvhNode], node: usize) -> usize {
+    let n = &nodes[node];
+    1 + (0..8)
+        .filter(|&c| !n.is_child_empty(c) && !n.is_leaf(c))
+        .map(|c| depth(nodes, n.child_node_index(c) as usize))
+        .max()
+        .unwrap_or(0)
+}
+
+trait TraversalStack {
+    fn push(&mut self, v: UVec2);
+    fn pop(&mut self) -> Option<UVec2>;
+}
+
+/// A stack in a fixed array (every level of the tree pushes at most one group, so a tree
+/// shallower than N cannot overflow it).
+struct FixedStack<const N: usize> {
+    data: [UVec2; N],
+    len: usize,
+}
+
+impl<const N: usize> FixedStack<N> {
+    fn new() -> Self {
+        FixedStack {
+            data: [UVec2::ZERO; N],
+            len: 0,
+        }
+    }
+}
+
+impl<const N: usize> TraversalStack for FixedStack<N> {
+    #[inline(always)]
+    fn push(&mut self, v: UVec2) {
+        self.data[self.len] = v;
+        self.len += 1;
+    }
+    #[inline(always)]
+    fn pop(&mut self) -> Option<UVec2> {
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        Some(self.data[self.len])
+    }
+}
+
+impl TraversalStack for Vec<UVec2> {
+    #[inline(always)]
+    fn push(&mut self, v: UVec2) {
+        Vec::push(self, v);
+    }
+    #[inline(always)]
+    fn pop(&mut self) -> Option<UVec2> {
+        Vec::pop(self)
+    }
+}
+
+/// Per-node slab constants. A child plane with quantised coordinate q lies at
+/// x = p + q·e (e a power of two), at ray distance t = q·a + b with a = e/d and
+/// b = (p − o)/d. Rounding: 1/d (one rounding), p − o and the product (two), q·a (exact e,
+/// one), the fused sum (one): |Δt| ≤ γ(4)·(|b| + q|a|). The builder's quantisation rounds
+/// (child.min − p)/e once before flooring, so a plane may sit up to u·256·e inside the
+/// true box: 256·u·|a| more. `margin` = γ(8)·(|b| + 256|a|) covers both with room to spare;
+/// near planes move nearer by it, far planes farther.
+#[inline(always)]
+fn slab_constants(node: &CwBvhNode, ray: &TraversalRay) -> (Vec3A, Vec3A, Vec3A) {
+    let e = Vec3A::new(
+        f32::from_bits((node.e[0] as u32) << 23),
+        f32::from_bits((node.e[1] as u32) << 23),
+        f32::from_bits((node.e[2] as u32) << 23),
+    );
+    let a = e * ray.inv_d;
+    let b = (Vec3A::from(node.p) - ray.o) * ray.inv_d;
+    let margin = (b.abs() + a.abs() * 256.0) * gamma(8);
+    (a, b - margin, b + margin)
+}
+
+/// Which children of `node` the ray's segment (0, t_max) meets, as the traversal's hit mask:
+/// internal children set bit 24 + (slot ^ octant), leaves set their triangles' bits.
+#[inline(always)]
+fn node_hitmask(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
+    let mask = child_mask(node, ray, t_max);
+    let (child_bits8, bit_index8) = node.get_child_and_index_bits(ray.oct_inv4);
+    let mut m = mask;
+    let mut hitmask = 0;
+    while m != 0 {
+        let j = m.trailing_zeros() * 8;
+        let child_bits = ((child_bits8 >> j) as u32) & 0xff;
+        let bit_index = ((bit_index8 >> j) as u32) & 0xff;
+        hitmask |= child_bits << bit_index;
+        m &= m - 1;
+    }
+    hitmask
+}
+
+/// Bit c set when child slot c's box meets the segment (empty slots may be set; their
+/// child bits are zero).
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    target_feature = "fma"
+))]
+#[inline(always)]
+fn child_mask(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
+    use std::arch::x86_64::*;
+    let (a, near_b, far_b) = slab_constants(node, ray);
+    // SAFETY: AVX2 and FMA are enabled for this build (cfg above); the loads read 8 bytes
+    // at field offsets inside `*node` (80 bytes, repr(C)).
+    unsafe {
+        let base = node as *const CwBvhNode as *const u8;
+        let load = |offset: usize| {
+            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(
+                base.add(offset) as *const __m128i
+            )))
+        };
+        let t_near = |k: usize, a: f32, b: f32| {
+            _mm256_fmadd_ps(load(ray.near[k]), _mm256_set1_ps(a), _mm256_set1_ps(b))
+        };
+        let t_far = |k: usize, a: f32, b: f32| {
+            _mm256_fmadd_ps(load(ray.far[k]), _mm256_set1_ps(a), _mm256_set1_ps(b))
+        };
+        let t_enter = _mm256_max_ps(
+            _mm256_max_ps(t_near(0, a.x, near_b.x), t_near(1, a.y, near_b.y)),
+            _mm256_max_ps(t_near(2, a.z, near_b.z), _mm256_setzero_ps()),
+        );
+        let t_exit = _mm256_min_ps(
+            _mm256_min_ps(t_far(0, a.x, far_b.x), t_far(1, a.y, far_b.y)),
+            _mm256_min_ps(t_far(2, a.z, far_b.z), _mm256_set1_ps(t_max)),
+        );
+        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_enter, t_exit)) as u32
+    }
+}
+
+#[cfg(not(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    target_feature = "fma"
+)))]
+#[inline(always)]
+fn child_mask(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
+    child_mask_scalar(node, ray, t_max)
+}
+
+/// Portable version of `child_mask` (also the reference for the SIMD one in tests).
+#[inline(always)]
+pub fn child_mask_scalar(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
+    let (a, near_b, far_b) = slab_constants(node, ray);
+    // SAFETY: the offsets are those of the six [u8; 8] plane arrays inside `*node`.
+    let planes = |offset: usize| unsafe {
+        *((node as *const CwBvhNode as *const u8).add(offset) as *const [u8; 8])
+    };
+    let near = [
+        planes(ray.near[0]),
+        planes(ray.near[1]),
+        planes(ray.near[2]),
+    ];
+    let far = [planes(ray.far[0]), planes(ray.far[1]), planes(ray.far[2])];
+    let mut mask = 0;
+    for c in 0..8 {
+        let mut t_enter = 0.0f32;
+        let mut t_exit = t_max;
+        for k in 0..3 {
+            t_enter = t_enter.max((near[k][c] as f32).mul_add(a[k], near_b[k]));
+            t_exit = t_exit.min((far[k][c] as f32).mul_add(a[k], far_b[k]));
+        }
+        if t_enter <= t_exit {
+            mask |= 1 << c;
+        }
+    }
+    mask
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn simd_child_mask_matches_scalar() {
+        let mut s = 12345u64;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        let mut tris = Vec::new();
+        for _ in 0..2000 {
+            let c = Vec3::new(next(), next(), next()) * 10.0;
+            let v = |c: Vec3, f: &mut dyn FnMut() -> f32| c + Vec3::new(f(), f(), f()) * 0.5;
+            tris.push([v(c, &mut next), v(c, &mut next), v(c, &mut next)]);
+        }
+        let ids: Vec<[u32; 2]> = (0..tris.len() as u32).map(|i| [0, i]).collect();
+        let bvh = TriangleBvh::build(&tris, &ids);
+        for _ in 0..2000 {
+            let o = Vec3::new(next(), next(), next()) * 12.0 - 1.0;
+            let d = (Vec3::new(next(), next(), next()) - 0.5).normalize();
+            let r = TraversalRay::new(o, d);
+            for node in &bvh.nodes {
+                let t_max = next() * 20.0;
+                assert_eq!(
+                    child_mask(node, &r, t_max),
+                    child_mask_scalar(node, &r, t_max)
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,438 @@
+//! Watertight ray/triangle intersection (Woop, Benthin & Wald, "Watertight Ray/Triangle
+//! Intersection", JCGT 2(1), 2013) and the hit point with its error bound.
+//!
+//! The ray is made the +z axis of a sheared coordinate system (a per-ray permutation and
+//! shear); the three vertices are transformed the same way whichever triangle they belong
+//! to, and the 2D edge functions are evaluated as `a·b − c·d` with no fused operations, so
+//! the edge shared by two triangles gets exactly opposite values in both: a ray cannot slip
+//! between them. An edge function that rounds to zero is recomputed in f64 (exact signs).
+//!
+//! On top of the paper's test, a hit is accepted only if its computed t is larger than a
+//! conservative bound on t's rounding error, so a ray leaving a triangle from an offset
+//! origin can never report that triangle again at t ≈ 0 (the same guard as Pharr et al.,
+//! PBR 4th ed. §6.8.6, with mltbench's own derivation below).
+
+use glam::Vec3;
+
+use super::offset::gamma;
+
+/// One triangle in the BVH's order, laid out for the test: `rows[k]` holds coordinate k of
+/// vertices 0, 1, 2, and a copy of vertex 0's in the fourth lane. With the copy, 4-wide sums
+/// and maxima over a row equal those over the three vertices, and the fourth lane of each
+/// edge function comes out as exactly zero.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[repr(C, align(16))]
+pub struct TriangleRecord {
+    pub rows: [[f32; 4]; 3],
+}
+
+impl TriangleRecord {
+    pub fn new(v0: Vec3, v1: Vec3, v2: Vec3) -> Self {
+        let row = |k: usize| [v0[k], v1[k], v2[k], v0[k]];
+        TriangleRecord {
+            rows: [row(0), row(1), row(2)],
+        }
+    }
+
+    pub fn vertex(&self, i: usize) -> Vec3 {
+        Vec3::new(self.rows[0][i], self.rows[1][i], self.rows[2][i])
+    }
+}
+
+/// Per-ray constants of the watertight test: the axis permutation (z = the direction's
+/// largest component, x/y swapped when it is negative to keep the winding) and the shear.
+#[derive(Clone, Copy, Debug)]
+pub struct TriangleRay {
+    pub kx: usize,
+    pub ky: usize,
+    pub kz: usize,
+    /// Origin coordinates along kx, ky, kz.
+    pub ox: f32,
+    pub oy: f32,
+    pub oz: f32,
+    pub sx: f32,
+    pub sy: f32,
+    pub sz: f32,
+}
+
+impl TriangleRay {
+    /// `d` must be non-zero and finite.
+    pub fn new(o: Vec3, d: Vec3) -> Self {
+        let a = d.abs();
+        let kz = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        let mut kx = (kz + 1) % 3;
+        let mut ky = (kx + 1) % 3;
+        if d[kz] < 0.0 {
+            std::mem::swap(&mut kx, &mut ky);
+        }
+        TriangleRay {
+            kx,
+            ky,
+            kz,
+            ox: o[kx],
+            oy: o[ky],
+            oz: o[kz],
+            sx: d[kx] / d[kz],
+            sy: d[ky] / d[kz],
+            sz: 1.0 / d[kz],
+        }
+    }
+}
+
+/// What the test found: the edge functions (proportional to the barycentrics of vertices
+/// 0, 1, 2) and their sum, both with the sign of the determinant.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TriangleHit {
+    pub t: f32,
+    pub e: [f32; 3],
+    pub det: f32,
+}
+
+impl TriangleHit {
+    /// Barycentrics (b0, b1, b2) of the hit: non-negative, summing to one up to rounding.
+    pub fn barycentrics(&self) -> [f32; 3] {
+        [
+            self.e[0] / self.det,
+            self.e[1] / self.det,
+            self.e[2] / self.det,
+        ]
+    }
+}
+
+/// The error-bound guard: true when the computed `t_num` (= t·det, |det|-scaled, already
+/// made positive) is larger than a bound on its rounding error, i.e. t's sign is certain.
+///
+/// Derivation (per lane i; `m(·)` is the maximum magnitude over the three vertices, `x,y,z`
+/// the sheared coordinates, `ax, ay` the unsheared differences v − o along kx, ky).
+/// The shear constants are taken as exact: they define the ray that is tested, and their
+/// own rounding only tilts it slightly, the same for every triangle.
+/// - z_i = fl(v − o) carries one rounding, zs_i = fl(z_i·sz) one more: δzs = γ(2)·m(zs).
+/// - x_i = fl(ax_i − fl(sx·z_i)): ax_i and z_i one rounding each, the product and the
+///   difference one each; |sx| ≤ 1: δx = γ(3)·(m(ax) + m(z) + m(x)), likewise δy.
+/// - e = x_j·y_k − y_j·x_k: input errors contribute m(x)·δy + m(y)·δx (+ δx·δy) per
+///   product, and the two products and the difference round: δe = 2·(m(x)·δy + m(y)·δx +
+///   δx·δy) + γ(2)·2·m(x)·m(y).
+/// - T = Σ e_i·zs_i (three products, two sums): δT = 3·(m(e)·δzs + m(zs)·δe + δe·δzs) +
+///   γ(3)·3·m(e)·m(zs).
+///
+/// The bounds use computed maxima in place of exact ones; γ(n) is taken one or two steps
+/// larger than counted to absorb that (a relative change of a few u).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn t_is_safe(
+    t_num: f32,
+    max_ax: f32,
+    max_ay: f32,
+    max_x: f32,
+    max_y: f32,
+    max_z: f32,
+    max_e: f32,
+    sz: f32,
+) -> bool {
+    let max_zs = max_z * sz.abs();
+    let d_zs = gamma(3) * max_zs;
+    let d_x = gamma(5) * (max_ax + max_z + max_x);
+    let d_y = gamma(5) * (max_ay + max_z + max_y);
+    let d_e = 2.0 * (max_x * d_y + max_y * d_x + d_x * d_y) + gamma(3) * 2.0 * max_x * max_y;
+    let d_t = 3.0 * (max_e * d_zs + max_zs * d_e + d_e * d_zs) + gamma(4) * 3.0 * max_e * max_zs;
+    t_num > d_t
+}
+
+/// The three edge functions recomputed in f64 from the same sheared f32 coordinates
+/// (products of two f32 are exact in f64; one rounding in the difference keeps the sign).
+#[inline(never)]
+#[cold]
+fn edges_f64(x: [f32; 3], y: [f32; 3]) -> [f64; 3] {
+    let (x, y) = (x.map(f64::from), y.map(f64::from));
+    [
+        x[2] * y[1] - y[2] * x[1],
+        x[0] * y[2] - y[0] * x[2],
+        x[1] * y[0] - y[1] * x[0],
+    ]
+}
+
+/// Portable reference implementation of the test. Returns the hit with 0 < t < t_max, if
+/// any (t in units of the ray direction the `TriangleRay` was made from).
+pub fn intersect_scalar(tri: &TriangleRecord, r: &TriangleRay, t_max: f32) -> Option<TriangleHit> {
+    let rx = &tri.rows[r.kx];
+    let ry = &tri.rows[r.ky];
+    let rz = &tri.rows[r.kz];
+    let mut ax = [0.0f32; 3];
+    let mut ay = [0.0f32; 3];
+    let mut z = [0.0f32; 3];
+    let mut x = [0.0f32; 3];
+    let mut y = [0.0f32; 3];
+    for i in 0..3 {
+        ax[i] = rx[i] - r.ox;
+        ay[i] = ry[i] - r.oy;
+        z[i] = rz[i] - r.oz;
+        x[i] = ax[i] - r.sx * z[i];
+        y[i] = ay[i] - r.sy * z[i];
+    }
+    let mut e = [
+        x[2] * y[1] - y[2] * x[1],
+        x[0] * y[2] - y[0] * x[2],
+        x[1] * y[0] - y[1] * x[0],
+    ];
+    finish(&mut e, ax, ay, x, y, z, r.sz, t_max)
+}
+
+/// The part of the test after the edge functions, shared by both implementations; written
+/// to perform the same operations in the same order as the SIMD path (bit-identical).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn finish(
+    e: &mut [f32; 3],
+    ax: [f32; 3],
+    ay: [f32; 3],
+    x: [f32; 3],
+    y: [f32; 3],
+    z: [f32; 3],
+    sz: f32,
+    t_max: f32,
+) -> Option<TriangleHit> {
+    let neg = e.iter().any(|&v| v < 0.0);
+    let pos = e.iter().any(|&v| v > 0.0);
+    if neg && pos {
+        return None;
+    }
+    if e.contains(&0.0) {
+        let e64 = edges_f64(x, y);
+        let neg = e64.iter().any(|&v| v < 0.0);
+        let pos = e64.iter().any(|&v| v > 0.0);
+        if neg && pos {
+            return None;
+        }
+        *e = e64.map(|v| v as f32);
+    }
+    let det = (e[0] + e[1]) + e[2];
+    if det == 0.0 {
+        return None;
+    }
+    let zs = z.map(|v| v * sz);
+    let t_num = (e[0] * zs[0] + e[1] * zs[1]) + e[2] * zs[2];
+    hit_from(
+        t_num,
+        det,
+        *e,
+        t_max,
+        || {
+            let m = |a: [f32; 3]| a[0].abs().max(a[1].abs()).max(a[2].abs());
+            (m(ax), m(ay), m(x), m(y), m(z), m(*e))
+        },
+        sz,
+    )
+}
+
+#[inline(always)]
+fn hit_from(
+    t_num: f32,
+    det: f32,
+    e: [f32; 3],
+    t_max: f32,
+    maxima: impl FnOnce() -> (f32, f32, f32, f32, f32, f32),
+    sz: f32,
+) -> Option<TriangleHit> {
+    // Make the determinant positive: t = T/det with both signs flipped.
+    let (t_num_p, det_p) = if det < 0.0 {
+        (-t_num, -det)
+    } else {
+        (t_num, det)
+    };
+    if !(t_num_p > 0.0 && t_num_p < t_max * det_p) {
+        return None;
+    }
+    let (max_ax, max_ay, max_x, max_y, max_z, max_e) = maxima();
+    if !t_is_safe(t_num_p, max_ax, max_ay, max_x, max_y, max_z, max_e, sz) {
+        return None;
+    }
+    let t = t_num_p / det_p;
+    (t < t_max).then_some(TriangleHit { t, e, det })
+}
+
+/// The test with 4-wide SSE arithmetic (one lane per vertex); same results as
+/// `intersect_scalar`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+pub fn intersect(tri: &TriangleRecord, r: &TriangleRay, t_max: f32) -> Option<TriangleHit> {
+    use std::arch::x86_64::*;
+    // Lane permutations: (2, 0, 1, 3) and (1, 2, 0, 3).
+    const P201: i32 = 0b11_01_00_10;
+    const P120: i32 = 0b11_00_10_01;
+    // SAFETY: SSE2 is part of the x86_64 baseline; the loads read whole 16-byte aligned
+    // rows of `tri` (`kx, ky, kz` < 3 by construction).
+    unsafe {
+        let rows = tri.rows.as_ptr() as *const f32;
+        let ax = _mm_sub_ps(_mm_load_ps(rows.add(4 * r.kx)), _mm_set1_ps(r.ox));
+        let ay = _mm_sub_ps(_mm_load_ps(rows.add(4 * r.ky)), _mm_set1_ps(r.oy));
+        let z = _mm_sub_ps(_mm_load_ps(rows.add(4 * r.kz)), _mm_set1_ps(r.oz));
+        let x = _mm_sub_ps(ax, _mm_mul_ps(_mm_set1_ps(r.sx), z));
+        let y = _mm_sub_ps(ay, _mm_mul_ps(_mm_set1_ps(r.sy), z));
+        let x201 = _mm_shuffle_ps::<P201>(x, x);
+        let y120 = _mm_shuffle_ps::<P120>(y, y);
+        let y201 = _mm_shuffle_ps::<P201>(y, y);
+        let x120 = _mm_shuffle_ps::<P120>(x, x);
+        let e = _mm_sub_ps(_mm_mul_ps(x201, y120), _mm_mul_ps(y201, x120));
+        let zero = _mm_setzero_ps();
+        let neg = _mm_movemask_ps(_mm_cmplt_ps(e, zero)) & 7;
+        let pos = _mm_movemask_ps(_mm_cmpgt_ps(e, zero)) & 7;
+        if neg != 0 && pos != 0 {
+            return None;
+        }
+        let lanes = |v: __m128| -> [f32; 4] {
+            let mut a = [0.0f32; 4];
+            _mm_storeu_ps(a.as_mut_ptr(), v);
+            a
+        };
+        let three = |a: [f32; 4]| [a[0], a[1], a[2]];
+        if (neg | pos) != 7 {
+            // Some edge function is zero (or the inputs were not finite): rare, scalar path.
+            let mut ev = three(lanes(e));
+            return finish(
+                &mut ev,
+                three(lanes(ax)),
+                three(lanes(ay)),
+                three(lanes(x)),
+                three(lanes(y)),
+                three(lanes(z)),
+                r.sz,
+                t_max,
+            );
+        }
+        // Horizontal sums as (l0 + l1) + (l2 + l3), lane 3 of e being exactly zero.
+        let hsum = |v: __m128| -> f32 {
+            let s = _mm_add_ps(v, _mm_shuffle_ps::<0b10_11_00_01>(v, v)); // (l0+l1, _, l2+l3, _)
+            _mm_cvtss_f32(_mm_add_ss(s, _mm_movehl_ps(s, s)))
+        };
+        let det = hsum(e);
+        if det == 0.0 {
+            return None;
+        }
+        let zs = _mm_mul_ps(z, _mm_set1_ps(r.sz));
+        let t_num = hsum(_mm_mul_ps(e, zs));
+        let ev = lanes(e);
+        hit_from(
+            t_num,
+            det,
+            [ev[0], ev[1], ev[2]],
+            t_max,
+            || {
+                let abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff));
+                let hmax = |v: __m128| -> f32 {
+                    let v = _mm_and_ps(v, abs_mask);
+                    let m = _mm_max_ps(v, _mm_shuffle_ps::<0b10_11_00_01>(v, v));
+                    _mm_cvtss_f32(_mm_max_ss(m, _mm_movehl_ps(m, m)))
+                };
+                (hmax(ax), hmax(ay), hmax(x), hmax(y), hmax(z), hmax(e))
+            },
+            r.sz,
+        )
+    }
+}
+
+#[cfg(not(target_arch = "x86_64"))]
+#[inline(always)]
+pub fn intersect(tri: &TriangleRecord, r: &TriangleRay, t_max: f32) -> Option<TriangleHit> {
+    intersect_scalar(tri, r, t_max)
+}
+
+/// The hit point Σ b_i·v_i and a bound on its error.
+///
+/// Take as the exact surface point the convex combination with the exact normalised
+/// barycentrics b_i = e_i / Σ e_j of the computed edge functions (non-negative, so it lies on
+/// the triangle; whether it is exactly the ray's hit does not matter for offsetting). The
+/// computed b̂_i went through the sum (two roundings, same-sign terms) and a division: within
+/// γ(3) of b_i relatively. The sum Σ b̂_i·v_i adds three rounded products: γ(3)·Σ|b̂_i v_i|
+/// more. So |p̂ − p| ≤ γ(3)·Σ|b_i v_i| + γ(3)·Σ|b̂_i v_i| ≤ γ(7)·Σ|b̂_i v_i| per coordinate;
+/// γ(8) leaves room for replacing b by b̂ in the bound.
+pub fn hit_point(v: [Vec3; 3], b: [f32; 3]) -> (Vec3, Vec3) {
+    let p = v[0] * b[0] + v[1] * b[1] + v[2] * b[2];
+    let sum_abs = (v[0] * b[0]).abs() + (v[1] * b[1]).abs() + (v[2] * b[2]).abs();
+    (p, sum_abs * gamma(8))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn rng(state: &mut u64) -> f32 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        (*state >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    #[test]
+    fn simd_and_scalar_agree_bit_for_bit() {
+        let mut s = 0x9E37_79B9_7F4A_7C15u64;
+        let mut hits = 0;
+        for i in 0..200_000 {
+            let mut v = || Vec3::new(rng(&mut s), rng(&mut s), rng(&mut s)) * 2.0 - 1.0;
+            let tri = TriangleRecord::new(v(), v(), v());
+            let o = v() * 3.0;
+            let mut d = v();
+            if i % 7 == 0 {
+                d.x = 0.0; // exercise exact-zero direction components
+            }
+            if d.length_squared() == 0.0 {
+                continue;
+            }
+            let r = TriangleRay::new(o, d);
+            let a = intersect(&tri, &r, f32::INFINITY);
+            let b = intersect_scalar(&tri, &r, f32::INFINITY);
+            assert_eq!(
+                a.map(|h| (h.t.to_bits(), h.det.to_bits())),
+                b.map(|h| (h.t.to_bits(), h.det.to_bits()))
+            );
+            hits += a.is_some() as u32;
+        }
+        assert!(hits > 1000);
+    }
+
+    #[test]
+    fn hits_the_middle_and_reports_barycentrics() {
+        let tri = TriangleRecord::new(Vec3::ZERO, Vec3::X, Vec3::Y);
+        let o = Vec3::new(0.25, 0.5, 2.0);
+        let r = TriangleRay::new(o, -Vec3::Z * 0.5);
+        let h = intersect(&tri, &r, f32::INFINITY).unwrap();
+        assert!((h.t - 4.0).abs() < 1e-6);
+        let b = h.barycentrics();
+        assert!(
+            (b[0] - 0.25).abs() < 1e-6 && (b[1] - 0.25).abs() < 1e-6 && (b[2] - 0.5).abs() < 1e-6
+        );
+        assert!(intersect(&tri, &r, 3.9).is_none());
+        // from behind, and pointing away
+        let below = Vec3::new(o.x, o.y, -o.z);
+        assert!(intersect(&tri, &TriangleRay::new(below, Vec3::Z), f32::INFINITY).is_some());
+        assert!(intersect(&tri, &TriangleRay::new(o, Vec3::Z), f32::INFINITY).is_none());
+    }
+
+    #[test]
+    fn shared_edge_is_hit_exactly_once_or_twice_never_zero() {
+        // Two triangles sharing the diagonal of a square; rays aimed exactly at the diagonal.
+        let (a, b, c, d) = (
+            Vec3::new(0.1, 0.2, 0.3),
+            Vec3::new(1.3, 0.1, 0.2),
+            Vec3::new(1.2, 1.4, 0.5),
+            Vec3::new(0.2, 1.1, 0.4),
+        );
+        let t1 = TriangleRecord::new(a, b, c);
+        let t2 = TriangleRecord::new(a, c, d);
+        let mut s = 7u64;
+        for _ in 0..100_000 {
+            let f = rng(&mut s);
+            let target = a + (c - a) * f;
+            let o = Vec3::new(rng(&mut s), rng(&mut s), 3.0 + rng(&mut s));
+            let r = TriangleRay::new(o, target - o);
+            let n = intersect(&t1, &r, f32::INFINITY).is_some() as u32
+                + intersect(&t2, &r, f32::INFINITY).is_some() as u32;
+            assert!(n >= 1, "ray slipped through the shared edge at f = {f}");
+        }
+    }
+}
