@@ -10,6 +10,7 @@ pub mod film;
 pub mod geometry;
 pub mod image;
 pub mod io;
+pub mod material;
 pub mod math;
 pub mod render;
 pub mod sampler;

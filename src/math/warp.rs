@@ -1,7 +1,12 @@
-//! Warps from the unit square to other domains, each with its pdf.
-//! (Filled in with the materials and lights: cosine hemisphere, sphere, cone, triangle, disk.)
+//! Warps from the unit square to other domains, each with its pdf (with respect to area on
+//! the target domain, or solid angle for directions).
+//!
+//! Every warp maps [0, 1)² onto its domain bijectively (up to measure zero) and preserves
+//! stratification, so that samplers which distribute points well on the square keep doing so.
 
 use glam::{Vec2, Vec3};
+
+use crate::math::{INV_PI, PI};
 
 /// Uniform point on a triangle as barycentrics (b1, b2) (Shirley & Chiu 1997 square-root map).
 pub fn square_to_triangle(u: Vec2) -> Vec2 {
@@ -15,4 +20,177 @@ pub fn square_to_sphere(u: Vec2) -> Vec3 {
     let r = (1.0 - z * z).max(0.0).sqrt();
     let phi = 2.0 * std::f32::consts::PI * u.y;
     Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Solid-angle density of `square_to_sphere`: 1/(4π).
+pub fn sphere_pdf() -> f32 {
+    0.25 * INV_PI
+}
+
+/// Uniform point on the unit disk by Shirley & Chiu's (1997) concentric map, which keeps
+/// neighbourhoods compact (low distortion); density 1/π.
+pub fn square_to_disk_concentric(u: Vec2) -> Vec2 {
+    let a = 2.0 * u.x - 1.0;
+    let b = 2.0 * u.y - 1.0;
+    if a == 0.0 && b == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, phi) = if a * a > b * b {
+        (a, (PI / 4.0) * (b / a))
+    } else {
+        (b, (PI / 2.0) - (PI / 4.0) * (a / b))
+    };
+    Vec2::new(r * phi.cos(), r * phi.sin())
+}
+
+/// Density of a uniform point on the unit disk: 1/π inside, 0 outside.
+pub fn disk_pdf(p: Vec2) -> f32 {
+    if p.length_squared() <= 1.0 {
+        INV_PI
+    } else {
+        0.0
+    }
+}
+
+/// Cosine-weighted direction on the upper hemisphere (z ≥ 0) by Malley's method: a uniform
+/// point on the disk lifted onto the hemisphere; pdf cos θ / π.
+pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3 {
+    let p = square_to_disk_concentric(u);
+    let z = (1.0 - p.length_squared()).max(0.0).sqrt();
+    Vec3::new(p.x, p.y, z)
+}
+
+/// Solid-angle density of `square_to_cosine_hemisphere`: cos θ / π above the surface, 0 below.
+pub fn cosine_hemisphere_pdf(w: Vec3) -> f32 {
+    if w.z > 0.0 { w.z * INV_PI } else { 0.0 }
+}
+
+/// Uniform direction on the upper hemisphere; pdf 1/(2π).
+pub fn square_to_uniform_hemisphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Solid-angle density of `square_to_uniform_hemisphere`.
+pub fn uniform_hemisphere_pdf(w: Vec3) -> f32 {
+    if w.z >= 0.0 { 0.5 * INV_PI } else { 0.0 }
+}
+
+/// Uniform direction in the cone of directions within angle acos(`cos_max`) of +z;
+/// pdf 1 / (2π (1 − cos_max)).
+pub fn square_to_uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
+    let z = 1.0 - u.x * (1.0 - cos_max);
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Solid-angle density of `square_to_uniform_cone`.
+pub fn uniform_cone_pdf(w: Vec3, cos_max: f32) -> f32 {
+    if w.z >= cos_max && cos_max < 1.0 {
+        0.5 * INV_PI / (1.0 - cos_max)
+    } else {
+        0.0
+    }
+}
+
+/// Direction on the upper hemisphere with density proportional to cosⁿθ about +z (the lobe of
+/// the modified Phong model, Lafortune & Willems 1994): pdf (n + 1)/(2π) cosⁿθ.
+/// Inverts the CDF 1 − cos^(n+1)θ.
+pub fn square_to_cosine_power(u: Vec2, exponent: f32) -> Vec3 {
+    // 1 − u.x is in (0, 1]: cos θ = (1 − u.x)^(1/(n+1)) never reaches 0 from the top end.
+    let z = (1.0 - u.x).powf(1.0 / (exponent + 1.0));
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// Solid-angle density of `square_to_cosine_power`.
+pub fn cosine_power_pdf(w: Vec3, exponent: f32) -> f32 {
+    if w.z > 0.0 {
+        (exponent + 1.0) * 0.5 * INV_PI * w.z.powf(exponent)
+    } else {
+        0.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A fixed, well-spread set of points of the unit square (a 64×64 jittered grid with a
+    /// deterministic hash for the jitter).
+    fn points() -> impl Iterator<Item = Vec2> {
+        (0..64u32).flat_map(|i| {
+            (0..64u32).map(move |j| {
+                let h = (i.wrapping_mul(0x9E37_79B9) ^ j.wrapping_mul(0x85EB_CA6B))
+                    .wrapping_mul(0xC2B2_AE35);
+                let jx = (h & 0xFFFF) as f32 / 65536.0;
+                let jy = (h >> 16) as f32 / 65536.0;
+                Vec2::new((i as f32 + jx) / 64.0, (j as f32 + jy) / 64.0)
+            })
+        })
+    }
+
+    #[test]
+    fn directions_are_unit_and_on_their_domain() {
+        for u in points() {
+            let d = square_to_disk_concentric(u);
+            assert!(d.length() <= 1.0 + 1e-6);
+            for (w, upper) in [
+                (square_to_cosine_hemisphere(u), true),
+                (square_to_uniform_hemisphere(u), true),
+                (square_to_uniform_cone(u, 0.8), true),
+                (square_to_cosine_power(u, 20.0), true),
+                (square_to_sphere(u), false),
+            ] {
+                assert!((w.length() - 1.0).abs() < 1e-5, "{w:?}");
+                assert!(!upper || w.z >= 0.0);
+            }
+            assert!(square_to_uniform_cone(u, 0.8).z >= 0.8 - 1e-6);
+        }
+    }
+
+    /// The mean of a test function under each warp equals its integral against the pdf,
+    /// computed independently in closed form: E[z] for each density.
+    #[test]
+    fn first_moments_match_closed_forms() {
+        let n = points().count() as f64;
+        let mean = |f: &dyn Fn(Vec2) -> f32| points().map(|u| f(u) as f64).sum::<f64>() / n;
+        // cosine hemisphere: E[cos θ] = ∫ cos² θ / π dω = 2/3
+        assert!((mean(&|u| square_to_cosine_hemisphere(u).z) - 2.0 / 3.0).abs() < 1e-3);
+        // uniform hemisphere: E[cos θ] = 1/2
+        assert!((mean(&|u| square_to_uniform_hemisphere(u).z) - 0.5).abs() < 1e-3);
+        // cone: z uniform on [cos_max, 1]
+        assert!((mean(&|u| square_to_uniform_cone(u, 0.6).z) - 0.8).abs() < 1e-3);
+        // cosine power n: E[cos θ] = (n + 1)/(n + 2)
+        assert!((mean(&|u| square_to_cosine_power(u, 9.0).z) - 10.0 / 11.0).abs() < 1e-3);
+        // disk: E[r²] = 1/2
+        assert!((mean(&|u| square_to_disk_concentric(u).length_squared()) - 0.5).abs() < 1e-3);
+    }
+
+    #[test]
+    fn pdfs_integrate_to_one() {
+        // Midpoint rule on a (cos θ, φ) grid: dω = d(cos θ) dφ.
+        let (nz, nphi) = (400, 64);
+        let integrate = |pdf: &dyn Fn(Vec3) -> f32| {
+            let mut sum = 0.0f64;
+            for i in 0..nz {
+                let z = -1.0 + 2.0 * (i as f32 + 0.5) / nz as f32;
+                let r = (1.0 - z * z).sqrt();
+                for j in 0..nphi {
+                    let phi = 2.0 * PI * (j as f32 + 0.5) / nphi as f32;
+                    sum += pdf(Vec3::new(r * phi.cos(), r * phi.sin(), z)) as f64;
+                }
+            }
+            sum * (2.0 / nz as f64) * (2.0 * std::f64::consts::PI / nphi as f64)
+        };
+        assert!((integrate(&cosine_hemisphere_pdf) - 1.0).abs() < 1e-3);
+        assert!((integrate(&uniform_hemisphere_pdf) - 1.0).abs() < 1e-2);
+        assert!((integrate(&|w| uniform_cone_pdf(w, 0.5)) - 1.0).abs() < 1e-2);
+        assert!((integrate(&|w| cosine_power_pdf(w, 5.0)) - 1.0).abs() < 1e-3);
+        assert!((integrate(&|_| sphere_pdf()) - 1.0).abs() < 1e-5);
+    }
 }
