@@ -10,7 +10,7 @@
 //! (`triangle.rs`). Triangle data are stored in the BVH's leaf order: a leaf's triangles
 //! are contiguous and need no index indirection.
 
-use glam::{UVec2, Vec3, Vec3A, uvec2};
+use glam::{UVec2, Vec2, Vec3, Vec3A, uvec2};
 use obvhs::{
     BvhBuildParams, bvh2::reinsertion::ReinsertionOptimizer, cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh,
     cwbvh::node::CwBvhNode, ploc::PlocBuilder, triangle::Triangle,
@@ -91,19 +91,32 @@ impl TraversalRay {
     }
 }
 
+/// What `TriangleBvh::build` needs per triangle. Vertex normals and uvs are optional per
+/// triangle (`None`: the mesh has none); they are stored in leaf order too, so the closest
+/// hit reads them from one place instead of chasing mesh indices.
+pub struct TriangleInput<'a> {
+    pub vertices: &'a [[Vec3; 3]],
+    /// (shape, primitive) of each triangle.
+    pub ids: &'a [[u32; 2]],
+    pub normals: Option<&'a [Option<[Vec3; 3]>]>,
+    pub uvs: Option<&'a [Option<[Vec2; 3]>]>,
+}
+
 /// The BVH and the triangles in its leaf order.
 #[derive(Default)]
 pub struct TriangleBvh {
     nodes: Vec<CwBvhNode>,
     records: Vec<TriangleRecord>,
-    /// (shape, primitive) of each record.
-    ids: Vec<[u32; 2]>,
+    /// Vertex normals per record (zero when the mesh has none), if any mesh has them.
+    normals: Option<Vec<[Vec3; 3]>>,
+    /// Vertex uvs per record (NaN when the mesh has none), if any mesh has them.
+    uvs: Option<Vec<[Vec2; 3]>>,
     depth: usize,
 }
 
 impl TriangleBvh {
-    /// `triangles[i]` has vertices `triangles[i]` and identity `ids[i]`.
-    pub fn build(triangles: &[[Vec3; 3]], ids: &[[u32; 2]]) -> TriangleBvh {
+    pub fn build(input: &TriangleInput) -> TriangleBvh {
+        let triangles = input.vertices;
         if triangles.is_empty() {
             return TriangleBvh::default();
         }
@@ -130,24 +143,32 @@ impl TriangleBvh {
         ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
         let cwbvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
         drop(bvh2);
-        let records = cwbvh
-            .primitive_indices
+        let order = &cwbvh.primitive_indices;
+        let records = order
             .iter()
             .map(|&i| {
-                let t = &triangles[i as usize];
-                TriangleRecord::new(t[0], t[1], t[2])
+                let [shape, primitive] = input.ids[i as usize];
+                TriangleRecord::new(triangles[i as usize], shape, primitive)
             })
             .collect();
-        let ids = cwbvh
-            .primitive_indices
-            .iter()
-            .map(|&i| ids[i as usize])
-            .collect();
+        let normals = input.normals.map(|n| {
+            order
+                .iter()
+                .map(|&i| n[i as usize].unwrap_or([Vec3::ZERO; 3]))
+                .collect()
+        });
+        let uvs = input.uvs.map(|uv| {
+            order
+                .iter()
+                .map(|&i| uv[i as usize].unwrap_or([Vec2::NAN; 3]))
+                .collect()
+        });
         let depth = depth(&cwbvh.nodes, 0);
         TriangleBvh {
             nodes: cwbvh.nodes,
             records,
-            ids,
+            normals,
+            uvs,
             depth,
         }
     }
@@ -156,9 +177,16 @@ impl TriangleBvh {
         &self.records[index as usize]
     }
 
-    /// (shape, primitive) of record `index`.
-    pub fn id(&self, index: u32) -> [u32; 2] {
-        self.ids[index as usize]
+    /// Vertex normals of record `index`, if its mesh has them.
+    pub fn normals(&self, index: u32) -> Option<&[Vec3; 3]> {
+        let n = &self.normals.as_ref()?[index as usize];
+        (n[0] != Vec3::ZERO || n[1] != Vec3::ZERO || n[2] != Vec3::ZERO).then_some(n)
+    }
+
+    /// Vertex uvs of record `index`, if its mesh has them.
+    pub fn uvs(&self, index: u32) -> Option<&[Vec2; 3]> {
+        let uv = &self.uvs.as_ref()?[index as usize];
+        (!uv[0].is_nan()).then_some(uv)
     }
 
     pub fn node_count(&self) -> usize {
@@ -176,6 +204,14 @@ impl TriangleBvh {
             if let Some(h) = triangle::intersect(&self.records[id as usize], &ray.tri, *t_max) {
                 *t_max = h.t;
                 best = Some(id);
+                // The surface data of the closest hit will be read from these: start
+                // fetching them while traversal goes on.
+                if let Some(n) = &self.normals {
+                    prefetch(&n[id as usize]);
+                }
+                if let Some(uv) = &self.uvs {
+                    prefetch(&uv[id as usize]);
+                }
             }
             false
         };
@@ -291,22 +327,35 @@ fn depth(nodes: &[CwBvhNode], node: usize) -> usize {
         .unwrap_or(0)
 }
 
+/// Hint the CPU to bring `*v`'s cache line in (no effect on results).
+#[inline(always)]
+fn prefetch<T>(v: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: prefetching never faults and `v` is a valid reference.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>(v as *const T as *const i8);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = v;
+}
+
 trait TraversalStack {
     fn push(&mut self, v: UVec2);
     fn pop(&mut self) -> Option<UVec2>;
 }
 
 /// A stack in a fixed array (every level of the tree pushes at most one group, so a tree
-/// shallower than N cannot overflow it).
+/// shallower than N cannot overflow it); left uninitialised, no per-ray clearing.
 struct FixedStack<const N: usize> {
-    data: [UVec2; N],
+    data: [std::mem::MaybeUninit<UVec2>; N],
     len: usize,
 }
 
 impl<const N: usize> FixedStack<N> {
     fn new() -> Self {
         FixedStack {
-            data: [UVec2::ZERO; N],
+            data: [std::mem::MaybeUninit::uninit(); N],
             len: 0,
         }
     }
@@ -315,7 +364,7 @@ impl<const N: usize> FixedStack<N> {
 impl<const N: usize> TraversalStack for FixedStack<N> {
     #[inline(always)]
     fn push(&mut self, v: UVec2) {
-        self.data[self.len] = v;
+        self.data[self.len].write(v);
         self.len += 1;
     }
     #[inline(always)]
@@ -324,7 +373,8 @@ impl<const N: usize> TraversalStack for FixedStack<N> {
             return None;
         }
         self.len -= 1;
-        Some(self.data[self.len])
+        // SAFETY: entries below `len` were written by `push`.
+        Some(unsafe { self.data[self.len].assume_init() })
     }
 }
 
@@ -474,7 +524,12 @@ mod tests {
             tris.push([v(c, &mut next), v(c, &mut next), v(c, &mut next)]);
         }
         let ids: Vec<[u32; 2]> = (0..tris.len() as u32).map(|i| [0, i]).collect();
-        let bvh = TriangleBvh::build(&tris, &ids);
+        let bvh = TriangleBvh::build(&TriangleInput {
+            vertices: &tris,
+            ids: &ids,
+            normals: None,
+            uvs: None,
+        });
         for _ in 0..2000 {
             let o = Vec3::new(next(), next(), next()) * 12.0 - 1.0;
             let d = (Vec3::new(next(), next(), next()) - 0.5).normalize();

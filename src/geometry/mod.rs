@@ -27,7 +27,7 @@ use glam::{Vec2, Vec3};
 use crate::math::Frame;
 use crate::scene::{ShapeDesc, ShapeGeometry};
 
-use bvh::{TraversalRay, TriangleBvh};
+use bvh::{TraversalRay, TriangleBvh, TriangleInput};
 use disk::Disk;
 use offset::offset_ray_origin;
 use sphere::Sphere;
@@ -165,13 +165,6 @@ impl Bounds3 {
     }
 }
 
-/// Per-vertex attributes of a mesh shape, read at hits.
-struct MeshAttributes {
-    indices: Vec<[u32; 3]>,
-    normals: Option<Vec<Vec3>>,
-    uvs: Option<Vec<Vec2>>,
-}
-
 /// The closest hit found by traversal (before computing surface data).
 enum Hit {
     Triangle {
@@ -188,29 +181,33 @@ enum Hit {
     },
 }
 
-/// A ray with unit direction, and what converts its distances back to the caller's units.
-struct NormalizedRay {
+/// The query ray with its direction scaled by a power of two so that its largest
+/// component lies in [1, 2): exactly the same ray (the scaling is exact), with slab
+/// reciprocals that cannot overflow whatever |d| the caller used. Distances t_s along it
+/// convert back exactly: t = t_s / scale.
+struct ScaledRay {
     o: Vec3,
     d: Vec3,
-    /// |ray.d|: caller's t = distance / len.
-    len: f32,
+    scale: f32,
     t_max: f32,
 }
 
-impl NormalizedRay {
+impl ScaledRay {
     /// None for rays that cannot hit anything (zero or non-finite direction, non-finite
     /// origin, t_max ≤ 0 or NaN).
-    fn new(ray: &Ray) -> Option<NormalizedRay> {
-        let len = ray.d.length();
-        if !(len > 0.0 && len.is_finite() && ray.o.is_finite() && ray.t_max > 0.0) {
+    fn new(ray: &Ray) -> Option<ScaledRay> {
+        let m = ray.d.abs().max_element();
+        if !(m > 0.0 && m.is_finite() && ray.o.is_finite() && ray.t_max > 0.0) {
             return None;
         }
-        let d = ray.d / len;
-        Some(NormalizedRay {
+        // 2^e for the binary exponent e of m (clamped so that 2^±e are normal f32).
+        let e = ((m.to_bits() >> 23) & 0xff) as i32 - 127;
+        let scale = f32::from_bits(((127 + e.clamp(-126, 126)) as u32) << 23);
+        Some(ScaledRay {
             o: ray.o,
-            d,
-            len,
-            t_max: ray.t_max * len,
+            d: ray.d / scale,
+            scale,
+            t_max: ray.t_max * scale,
         })
     }
 }
@@ -218,8 +215,6 @@ impl NormalizedRay {
 /// The acceleration structure over all shapes of a scene.
 pub struct Geometry {
     bvh: TriangleBvh,
-    /// Indexed by shape; `Some` for meshes.
-    meshes: Vec<Option<MeshAttributes>>,
     spheres: Vec<Sphere>,
     disks: Vec<Disk>,
     bounds: Bounds3,
@@ -236,7 +231,22 @@ impl Geometry {
     pub fn build(shapes: &[ShapeDesc]) -> Geometry {
         let mut triangles = Vec::new();
         let mut ids = Vec::new();
-        let mut meshes = Vec::with_capacity(shapes.len());
+        // Per-triangle vertex attributes, gathered only if some mesh has them.
+        let valid_len = |m: &crate::scene::TriangleMesh, len: Option<usize>| {
+            len.is_some_and(|l| l == m.positions.len())
+        };
+        let meshes = shapes.iter().filter_map(|s| match &s.geometry {
+            ShapeGeometry::Mesh(m) => Some(m),
+            _ => None,
+        });
+        let any_normals = meshes
+            .clone()
+            .any(|m| valid_len(m, m.normals.as_ref().map(Vec::len)));
+        let any_uvs = meshes
+            .clone()
+            .any(|m| valid_len(m, m.uvs.as_ref().map(Vec::len)));
+        let mut normals = Vec::new();
+        let mut uvs = Vec::new();
         let mut spheres = Vec::new();
         let mut disks = Vec::new();
         let mut bounds = Bounds3::EMPTY;
@@ -247,6 +257,8 @@ impl Geometry {
             match &shape.geometry {
                 ShapeGeometry::Mesh(mesh) => {
                     let n = mesh.positions.len();
+                    let mesh_normals = mesh.normals.as_ref().filter(|v| v.len() == n);
+                    let mesh_uvs = mesh.uvs.as_ref().filter(|v| v.len() == n);
                     for (pi, idx) in mesh.indices.iter().enumerate() {
                         if idx.iter().any(|&i| i as usize >= n) {
                             skipped_triangles += 1;
@@ -263,15 +275,15 @@ impl Geometry {
                         }
                         triangles.push(v);
                         ids.push([si, pi as u32]);
+                        if any_normals {
+                            normals.push(mesh_normals.map(|n| idx.map(|i| n[i as usize])));
+                        }
+                        if any_uvs {
+                            uvs.push(mesh_uvs.map(|uv| idx.map(|i| uv[i as usize])));
+                        }
                     }
-                    meshes.push(Some(MeshAttributes {
-                        indices: mesh.indices.clone(),
-                        normals: mesh.normals.clone().filter(|v| v.len() == n),
-                        uvs: mesh.uvs.clone().filter(|v| v.len() == n),
-                    }));
                 }
                 ShapeGeometry::Sphere { center, radius } => {
-                    meshes.push(None);
                     let s = Sphere {
                         center: *center,
                         radius: *radius,
@@ -287,7 +299,6 @@ impl Geometry {
                     }
                 }
                 ShapeGeometry::Disk { to_world } => {
-                    meshes.push(None);
                     match Disk::new(to_world, shape.flip_normals, si) {
                         Some(d) => {
                             let (lo, hi) = d.bounds();
@@ -300,10 +311,14 @@ impl Geometry {
             }
         }
         let triangle_count = triangles.len();
-        let bvh = TriangleBvh::build(&triangles, &ids);
+        let bvh = TriangleBvh::build(&TriangleInput {
+            vertices: &triangles,
+            ids: &ids,
+            normals: any_normals.then_some(normals.as_slice()),
+            uvs: any_uvs.then_some(uvs.as_slice()),
+        });
         Geometry {
             bvh,
-            meshes,
             spheres,
             disks,
             bounds,
@@ -330,7 +345,7 @@ impl Geometry {
 
     /// Closest hit along the ray, if any, with t < ray.t_max.
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
-        let r = NormalizedRay::new(ray)?;
+        let r = ScaledRay::new(ray)?;
         let mut t_max64 = r.t_max as f64;
         let mut hit = None;
         for (index, s) in self.spheres.iter().enumerate() {
@@ -355,14 +370,14 @@ impl Geometry {
             hit = Some(Hit::Triangle { record });
         }
         match hit? {
-            Hit::Triangle { record } => self.triangle_interaction(record, &traversal, r.len),
+            Hit::Triangle { record } => self.triangle_interaction(record, &traversal, r.scale),
             Hit::Sphere { index, t } => {
                 let s = &self.spheres[index];
                 let h = s.hit(r.o, r.d, t);
                 Some(interaction(
                     h.p,
                     h.p_error,
-                    (t / r.len as f64) as f32,
+                    (t / r.scale as f64) as f32,
                     h.n,
                     h.n,
                     h.uv,
@@ -376,7 +391,7 @@ impl Geometry {
                 Some(interaction(
                     h.p,
                     h.p_error,
-                    (t / r.len as f64) as f32,
+                    (t / r.scale as f64) as f32,
                     h.n,
                     h.n,
                     h.uv,
@@ -389,7 +404,7 @@ impl Geometry {
 
     /// True when anything lies on the ray with t < ray.t_max (any-hit shadow query).
     pub fn occluded(&self, ray: &Ray) -> bool {
-        let Some(r) = NormalizedRay::new(ray) else {
+        let Some(r) = ScaledRay::new(ray) else {
             return false;
         };
         let t_max64 = r.t_max as f64;
@@ -411,7 +426,7 @@ impl Geometry {
         &self,
         record: u32,
         ray: &TraversalRay,
-        len: f32,
+        scale: f32,
     ) -> Option<SurfaceInteraction> {
         let h = self.bvh.hit(record, ray)?;
         let rec = self.bvh.record(record);
@@ -419,26 +434,22 @@ impl Geometry {
         let b = h.barycentrics();
         let (p, p_error) = triangle::hit_point(v, b);
         let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
-        let [shape, primitive] = self.bvh.id(record);
-        let mut ns = ng;
-        let mut uv = Vec2::new(b[1], b[2]);
-        if let Some(mesh) = self.meshes[shape as usize].as_ref() {
-            let idx = mesh.indices[primitive as usize].map(|i| i as usize);
-            if let Some(normals) = &mesh.normals {
-                let n = normals[idx[0]] * b[0] + normals[idx[1]] * b[1] + normals[idx[2]] * b[2];
-                let n = n.normalize_or_zero();
-                if n != Vec3::ZERO {
-                    ns = n;
-                }
-            }
-            if let Some(uvs) = &mesh.uvs {
-                uv = uvs[idx[0]] * b[0] + uvs[idx[1]] * b[1] + uvs[idx[2]] * b[2];
-            }
-        }
+        let [shape, primitive] = rec.ids();
+        let ns = self
+            .bvh
+            .normals(record)
+            .map(|n| (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).normalize_or_zero())
+            .filter(|n| *n != Vec3::ZERO)
+            .unwrap_or(ng);
+        let uv = self
+            .bvh
+            .uvs(record)
+            .map(|uv| uv[0] * b[0] + uv[1] * b[1] + uv[2] * b[2])
+            .unwrap_or(Vec2::new(b[1], b[2]));
         Some(interaction(
             p,
             p_error,
-            h.t / len,
+            h.t / scale,
             ng,
             ns,
             uv,

@@ -7,28 +7,45 @@
 //! the edge shared by two triangles gets exactly opposite values in both: a ray cannot slip
 //! between them. An edge function that rounds to zero is recomputed in f64 (exact signs).
 //!
-//! On top of the paper's test, a hit is accepted only if its computed t is larger than a
-//! conservative bound on t's rounding error, so a ray leaving a triangle from an offset
-//! origin can never report that triangle again at t ≈ 0 (the same guard as Pharr et al.,
-//! PBR 4th ed. §6.8.6, with mltbench's own derivation below).
+//! The sign of t is then decided separately, in f64, from the original vertices: the
+//! origin's side of the triangle's plane against the direction's. That is exact to ~1e-16
+//! relative, far below the f32 offsets of spawned ray origins, so a ray leaving a triangle
+//! can never report it again at t ≈ 0, and a legitimate hit however close to the origin is
+//! kept. (Pharr et al., PBR 4th ed. §6.8.6, instead reject t below an error bound on t; that
+//! bound is loose by orders of magnitude and dropped real hits up to ~1e-5 of the triangle's
+//! size from the origin in mltbench's tests.)
 
 use glam::Vec3;
 
 use super::offset::gamma;
 
 /// One triangle in the BVH's order, laid out for the test: `rows[k]` holds coordinate k of
-/// vertices 0, 1, 2, and a copy of vertex 0's in the fourth lane. With the copy, 4-wide sums
-/// and maxima over a row equal those over the three vertices, and the fourth lane of each
-/// edge function comes out as exactly zero.
+/// vertices 0, 1, 2. The fourth lanes carry the triangle's (shape, primitive) identity, so
+/// the closest hit needs no further memory access to name it; they hold floats in [1, 2)
+/// (23 payload bits each, never denormal or NaN), and the SIMD test masks that lane out of
+/// every sum, maximum and sign test.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 #[repr(C, align(16))]
 pub struct TriangleRecord {
     pub rows: [[f32; 4]; 3],
 }
 
+const PAYLOAD: u32 = 0x7f_ffff;
+
+fn encode(bits: u32) -> f32 {
+    f32::from_bits(0x3f80_0000 | (bits & PAYLOAD))
+}
+
+fn decode(v: f32) -> u32 {
+    v.to_bits() & PAYLOAD
+}
+
 impl TriangleRecord {
-    pub fn new(v0: Vec3, v1: Vec3, v2: Vec3) -> Self {
-        let row = |k: usize| [v0[k], v1[k], v2[k], v0[k]];
+    pub fn new(v: [Vec3; 3], shape: u32, primitive: u32) -> Self {
+        // The low 23 bits of each id in rows 0 and 1, the 9 + 9 high bits in row 2.
+        let high = (shape >> 23) | ((primitive >> 23) << 9);
+        let ids = [encode(shape), encode(primitive), encode(high)];
+        let row = |k: usize| [v[0][k], v[1][k], v[2][k], ids[k]];
         TriangleRecord {
             rows: [row(0), row(1), row(2)],
         }
@@ -36,6 +53,15 @@ impl TriangleRecord {
 
     pub fn vertex(&self, i: usize) -> Vec3 {
         Vec3::new(self.rows[0][i], self.rows[1][i], self.rows[2][i])
+    }
+
+    /// (shape, primitive) given to `new`.
+    pub fn ids(&self) -> [u32; 2] {
+        let high = decode(self.rows[2][3]);
+        [
+            decode(self.rows[0][3]) | ((high & 0x1ff) << 23),
+            decode(self.rows[1][3]) | ((high >> 9) << 23),
+        ]
     }
 }
 
@@ -53,6 +79,9 @@ pub struct TriangleRay {
     pub sx: f32,
     pub sy: f32,
     pub sz: f32,
+    /// The ray itself, for the f64 sign test.
+    pub o: Vec3,
+    pub d: Vec3,
 }
 
 impl TriangleRay {
@@ -81,6 +110,8 @@ impl TriangleRay {
             sx: d[kx] / d[kz],
             sy: d[ky] / d[kz],
             sz: 1.0 / d[kz],
+            o,
+            d,
         }
     }
 }
@@ -105,43 +136,18 @@ impl TriangleHit {
     }
 }
 
-/// The error-bound guard: true when the computed `t_num` (= t·det, |det|-scaled, already
-/// made positive) is larger than a bound on its rounding error, i.e. t's sign is certain.
-///
-/// Derivation (per lane i; `m(·)` is the maximum magnitude over the three vertices, `x,y,z`
-/// the sheared coordinates, `ax, ay` the unsheared differences v − o along kx, ky).
-/// The shear constants are taken as exact: they define the ray that is tested, and their
-/// own rounding only tilts it slightly, the same for every triangle.
-/// - z_i = fl(v − o) carries one rounding, zs_i = fl(z_i·sz) one more: δzs = γ(2)·m(zs).
-/// - x_i = fl(ax_i − fl(sx·z_i)): ax_i and z_i one rounding each, the product and the
-///   difference one each; |sx| ≤ 1: δx = γ(3)·(m(ax) + m(z) + m(x)), likewise δy.
-/// - e = x_j·y_k − y_j·x_k: input errors contribute m(x)·δy + m(y)·δx (+ δx·δy) per
-///   product, and the two products and the difference round: δe = 2·(m(x)·δy + m(y)·δx +
-///   δx·δy) + γ(2)·2·m(x)·m(y).
-/// - T = Σ e_i·zs_i (three products, two sums): δT = 3·(m(e)·δzs + m(zs)·δe + δe·δzs) +
-///   γ(3)·3·m(e)·m(zs).
-///
-/// The bounds use computed maxima in place of exact ones; γ(n) is taken one or two steps
-/// larger than counted to absorb that (a relative change of a few u).
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn t_is_safe(
-    t_num: f32,
-    max_ax: f32,
-    max_ay: f32,
-    max_x: f32,
-    max_y: f32,
-    max_z: f32,
-    max_e: f32,
-    sz: f32,
-) -> bool {
-    let max_zs = max_z * sz.abs();
-    let d_zs = gamma(3) * max_zs;
-    let d_x = gamma(5) * (max_ax + max_z + max_x);
-    let d_y = gamma(5) * (max_ay + max_z + max_y);
-    let d_e = 2.0 * (max_x * d_y + max_y * d_x + d_x * d_y) + gamma(3) * 2.0 * max_x * max_y;
-    let d_t = 3.0 * (max_e * d_zs + max_zs * d_e + d_e * d_zs) + gamma(4) * 3.0 * max_e * max_zs;
-    t_num > d_t
+/// Whether the exact ray meets the triangle's plane at t > 0: the origin lies on the side
+/// of the plane opposite to where the direction points, n·(v0 − o) and n·d of equal signs.
+/// In f64 from the f32 inputs: the differences are exact, the cross product rounds once,
+/// the dot products a few times, all relative to ~2⁻⁵², so the sign is wrong only for an
+/// origin within ~1e-15·|v0 − o| of the plane (spawned origins sit ~1e-7 away).
+#[inline(never)]
+fn t_is_positive(tri: &TriangleRecord, r: &TriangleRay) -> bool {
+    let v = [0, 1, 2].map(|i| tri.vertex(i).as_dvec3());
+    let n = (v[1] - v[0]).cross(v[2] - v[0]);
+    let side = n.dot(v[0] - r.o.as_dvec3());
+    let towards = n.dot(r.d.as_dvec3());
+    (side > 0.0 && towards > 0.0) || (side < 0.0 && towards < 0.0)
 }
 
 /// The three edge functions recomputed in f64 from the same sheared f32 coordinates
@@ -180,21 +186,19 @@ pub fn intersect_scalar(tri: &TriangleRecord, r: &TriangleRay, t_max: f32) -> Op
         x[0] * y[2] - y[0] * x[2],
         x[1] * y[0] - y[1] * x[0],
     ];
-    finish(&mut e, ax, ay, x, y, z, r.sz, t_max)
+    finish(tri, r, &mut e, x, y, z, t_max)
 }
 
 /// The part of the test after the edge functions, shared by both implementations; written
 /// to perform the same operations in the same order as the SIMD path (bit-identical).
-#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 fn finish(
+    tri: &TriangleRecord,
+    r: &TriangleRay,
     e: &mut [f32; 3],
-    ax: [f32; 3],
-    ay: [f32; 3],
     x: [f32; 3],
     y: [f32; 3],
     z: [f32; 3],
-    sz: f32,
     t_max: f32,
 ) -> Option<TriangleHit> {
     let neg = e.iter().any(|&v| v < 0.0);
@@ -215,29 +219,20 @@ fn finish(
     if det == 0.0 {
         return None;
     }
-    let zs = z.map(|v| v * sz);
+    let zs = z.map(|v| v * r.sz);
     let t_num = (e[0] * zs[0] + e[1] * zs[1]) + e[2] * zs[2];
-    hit_from(
-        t_num,
-        det,
-        *e,
-        t_max,
-        || {
-            let m = |a: [f32; 3]| a[0].abs().max(a[1].abs()).max(a[2].abs());
-            (m(ax), m(ay), m(x), m(y), m(z), m(*e))
-        },
-        sz,
-    )
+    hit_from(tri, r, t_num, det, *e, t_max)
 }
 
+/// Accepts the candidate: t = T/det within (0, t_max), the sign of t confirmed in f64.
 #[inline(always)]
 fn hit_from(
+    tri: &TriangleRecord,
+    r: &TriangleRay,
     t_num: f32,
     det: f32,
     e: [f32; 3],
     t_max: f32,
-    maxima: impl FnOnce() -> (f32, f32, f32, f32, f32, f32),
-    sz: f32,
 ) -> Option<TriangleHit> {
     // Make the determinant positive: t = T/det with both signs flipped.
     let (t_num_p, det_p) = if det < 0.0 {
@@ -245,11 +240,7 @@ fn hit_from(
     } else {
         (t_num, det)
     };
-    if !(t_num_p > 0.0 && t_num_p < t_max * det_p) {
-        return None;
-    }
-    let (max_ax, max_ay, max_x, max_y, max_z, max_e) = maxima();
-    if !t_is_safe(t_num_p, max_ax, max_ay, max_x, max_y, max_z, max_e, sz) {
+    if !(t_num_p > 0.0 && t_num_p < t_max * det_p && t_is_positive(tri, r)) {
         return None;
     }
     let t = t_num_p / det_p;
@@ -278,7 +269,12 @@ pub fn intersect(tri: &TriangleRecord, r: &TriangleRay, t_max: f32) -> Option<Tr
         let y120 = _mm_shuffle_ps::<P120>(y, y);
         let y201 = _mm_shuffle_ps::<P201>(y, y);
         let x120 = _mm_shuffle_ps::<P120>(x, x);
-        let e = _mm_sub_ps(_mm_mul_ps(x201, y120), _mm_mul_ps(y201, x120));
+        // Lanes 0-2 only: the fourth lane holds identity bits, not a vertex.
+        let lanes012 = _mm_castsi128_ps(_mm_set_epi32(0, -1, -1, -1));
+        let e = _mm_and_ps(
+            _mm_sub_ps(_mm_mul_ps(x201, y120), _mm_mul_ps(y201, x120)),
+            lanes012,
+        );
         let zero = _mm_setzero_ps();
         let neg = _mm_movemask_ps(_mm_cmplt_ps(e, zero)) & 7;
         let pos = _mm_movemask_ps(_mm_cmpgt_ps(e, zero)) & 7;
@@ -295,17 +291,16 @@ pub fn intersect(tri: &TriangleRecord, r: &TriangleRay, t_max: f32) -> Option<Tr
             // Some edge function is zero (or the inputs were not finite): rare, scalar path.
             let mut ev = three(lanes(e));
             return finish(
+                tri,
+                r,
                 &mut ev,
-                three(lanes(ax)),
-                three(lanes(ay)),
                 three(lanes(x)),
                 three(lanes(y)),
                 three(lanes(z)),
-                r.sz,
                 t_max,
             );
         }
-        // Horizontal sums as (l0 + l1) + (l2 + l3), lane 3 of e being exactly zero.
+        // Horizontal sums as (l0 + l1) + (l2 + l3), lane 3 being zero.
         let hsum = |v: __m128| -> f32 {
             let s = _mm_add_ps(v, _mm_shuffle_ps::<0b10_11_00_01>(v, v)); // (l0+l1, _, l2+l3, _)
             _mm_cvtss_f32(_mm_add_ss(s, _mm_movehl_ps(s, s)))
@@ -315,24 +310,9 @@ pub fn intersect(tri: &TriangleRecord, r: &TriangleRay, t_max: f32) -> Option<Tr
             return None;
         }
         let zs = _mm_mul_ps(z, _mm_set1_ps(r.sz));
-        let t_num = hsum(_mm_mul_ps(e, zs));
+        let t_num = hsum(_mm_and_ps(_mm_mul_ps(e, zs), lanes012));
         let ev = lanes(e);
-        hit_from(
-            t_num,
-            det,
-            [ev[0], ev[1], ev[2]],
-            t_max,
-            || {
-                let abs_mask = _mm_castsi128_ps(_mm_set1_epi32(0x7fff_ffff));
-                let hmax = |v: __m128| -> f32 {
-                    let v = _mm_and_ps(v, abs_mask);
-                    let m = _mm_max_ps(v, _mm_shuffle_ps::<0b10_11_00_01>(v, v));
-                    _mm_cvtss_f32(_mm_max_ss(m, _mm_movehl_ps(m, m)))
-                };
-                (hmax(ax), hmax(ay), hmax(x), hmax(y), hmax(z), hmax(e))
-            },
-            r.sz,
-        )
+        hit_from(tri, r, t_num, det, [ev[0], ev[1], ev[2]], t_max)
     }
 }
 
@@ -372,9 +352,9 @@ mod tests {
     fn simd_and_scalar_agree_bit_for_bit() {
         let mut s = 0x9E37_79B9_7F4A_7C15u64;
         let mut hits = 0;
-        for i in 0..200_000 {
+        for i in 0..200_000u32 {
             let mut v = || Vec3::new(rng(&mut s), rng(&mut s), rng(&mut s)) * 2.0 - 1.0;
-            let tri = TriangleRecord::new(v(), v(), v());
+            let tri = TriangleRecord::new([v(), v(), v()], i, 7 * i);
             let o = v() * 3.0;
             let mut d = v();
             if i % 7 == 0 {
@@ -397,7 +377,10 @@ mod tests {
 
     #[test]
     fn hits_the_middle_and_reports_barycentrics() {
-        let tri = TriangleRecord::new(Vec3::ZERO, Vec3::X, Vec3::Y);
+        let tri = TriangleRecord::new([Vec3::ZERO, Vec3::X, Vec3::Y], 3, 4);
+        assert_eq!(tri.ids(), [3, 4]);
+        let big = TriangleRecord::new([Vec3::ZERO; 3], u32::MAX, 0x9abc_def1);
+        assert_eq!(big.ids(), [u32::MAX, 0x9abc_def1]);
         let o = Vec3::new(0.25, 0.5, 2.0);
         let r = TriangleRay::new(o, -Vec3::Z * 0.5);
         let h = intersect(&tri, &r, f32::INFINITY).unwrap();
@@ -422,8 +405,8 @@ mod tests {
             Vec3::new(1.2, 1.4, 0.5),
             Vec3::new(0.2, 1.1, 0.4),
         );
-        let t1 = TriangleRecord::new(a, b, c);
-        let t2 = TriangleRecord::new(a, c, d);
+        let t1 = TriangleRecord::new([a, b, c], 0, 0);
+        let t2 = TriangleRecord::new([a, c, d], 0, 1);
         let mut s = 7u64;
         for _ in 0..100_000 {
             let f = rng(&mut s);
