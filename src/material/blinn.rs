@@ -11,7 +11,7 @@ use glam::{Vec2, Vec3};
 
 use crate::material::plastic::lobe_weight;
 use crate::material::{
-    BsdfFlags, BsdfModel, BsdfSample, TransportMode, reflect_about, valid_weight,
+    BsdfFlags, BsdfModel, BsdfSample, TransportMode, reflect_about, reflection_sample, valid_weight,
 };
 use crate::math::warp::{
     cosine_hemisphere_pdf, cosine_power_pdf, square_to_cosine_hemisphere, square_to_cosine_power,
@@ -94,21 +94,7 @@ impl BsdfModel for Blinn {
         } else {
             square_to_cosine_hemisphere(u)
         };
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.pdf(wo, wi);
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            return None;
-        }
-        let weight = self.eval(wo, wi, mode) * (wi.z / pdf);
-        valid_weight(weight).then_some(BsdfSample {
-            wi,
-            weight,
-            pdf,
-            delta: false,
-            eta: 1.0,
-        })
+        reflection_sample(self, wo, wi, mode)
     }
 
     fn flags(&self) -> BsdfFlags {

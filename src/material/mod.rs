@@ -348,6 +348,31 @@ pub fn reflect_about(w: Vec3, m: Vec3) -> Vec3 {
 
 /// A weight that must be finite and non-negative, or the sample is dropped.
 #[inline]
+/// Completes a sampled reflection direction `wi` of a non-delta, reflection-only model:
+/// its pdf, and the weight f·cos θi/pdf; None below the surface or for a degenerate pdf.
+pub(crate) fn reflection_sample(
+    model: &impl BsdfModel,
+    wo: Vec3,
+    wi: Vec3,
+    mode: TransportMode,
+) -> Option<BsdfSample> {
+    if wi.z <= 0.0 {
+        return None;
+    }
+    let pdf = model.pdf(wo, wi);
+    if !(pdf > 0.0 && pdf.is_finite()) {
+        return None;
+    }
+    let weight = model.eval(wo, wi, mode) * (wi.z / pdf);
+    valid_weight(weight).then_some(BsdfSample {
+        wi,
+        weight,
+        pdf,
+        delta: false,
+        eta: 1.0,
+    })
+}
+
 pub(crate) fn valid_weight(w: Rgb) -> bool {
     w.is_valid_radiance()
 }

@@ -26,7 +26,8 @@ use crate::material::microfacet::beckmann_visible_slopes;
 use crate::material::plastic::{internal_scattering, lobe_weight};
 use crate::material::quadrature::gauss_legendre;
 use crate::material::{
-    BsdfFlags, BsdfModel, BsdfSample, Microfacet, TransportMode, reflect_about, valid_weight,
+    BsdfFlags, BsdfModel, BsdfSample, Microfacet, TransportMode, reflect_about, reflection_sample,
+    valid_weight,
 };
 use crate::math::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
 use crate::math::{INV_PI, Rgb};
@@ -172,21 +173,7 @@ impl BsdfModel for RoughPlastic {
         } else {
             square_to_cosine_hemisphere(u)
         };
-        if wi.z <= 0.0 {
-            return None;
-        }
-        let pdf = self.pdf(wo, wi);
-        if !(pdf > 0.0 && pdf.is_finite()) {
-            return None;
-        }
-        let weight = self.eval(wo, wi, mode) * (wi.z / pdf);
-        valid_weight(weight).then_some(BsdfSample {
-            wi,
-            weight,
-            pdf,
-            delta: false,
-            eta: 1.0,
-        })
+        reflection_sample(self, wo, wi, mode)
     }
 
     fn flags(&self) -> BsdfFlags {
