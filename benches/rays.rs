@@ -1,1 +1,180 @@
-fn main() {}
+//! Ray casting throughput: closest-hit queries (`Geometry::intersect`, full surface data)
+//! per second on one and two threads, coherent camera rays and incoherent rays, plus the
+//! any-hit query and the build time, on two scenes:
+//! 1. the Cornell box (556 units) with a ~100k-triangle UV sphere,
+//! 2. a smooth displaced sphere of ~1M triangles.
+//!
+//! `cargo bench --bench rays` (criterion prints rays/s as "elem/s"). Figures depend on the
+//! CPU features the build targets (`.cargo/config.toml`: target-cpu=native); state them
+//! with every figure (`rustc --print cfg -C target-cpu=native | grep feature`).
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{Criterion, Throughput, criterion_group, criterion_main};
+use glam::Vec3;
+use mltbench::geometry::procedural::{cornell_box_with_sphere, displaced_sphere_1m, mesh_shape};
+use mltbench::geometry::{Geometry, Ray};
+use mltbench::scene::ShapeDesc;
+use rayon::prelude::*;
+
+/// Rays per batch: a 512×512 image of camera rays, or as many incoherent rays.
+const WIDTH: u32 = 512;
+const HEIGHT: u32 = 512;
+/// Rays per parallel work item (8 image rows: keeps coherent rays together).
+const CHUNK: usize = 8 * WIDTH as usize;
+
+/// SplitMix64 (Steele et al. 2014): a small, seedable generator for the ray sets.
+struct SplitMix(u64);
+
+impl SplitMix {
+    fn next_f32(&mut self) -> f32 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
+/// Camera rays of a pinhole at `eye` looking at `target` (vertical field of view `fov_y`
+/// degrees), one jittered ray per pixel, in scanline order.
+fn camera_rays(eye: Vec3, target: Vec3, fov_y: f32, seed: u64) -> Vec<Ray> {
+    let mut rng = SplitMix(seed);
+    let forward = (target - eye).normalize();
+    let right = forward.cross(Vec3::Y).normalize();
+    let up = right.cross(forward);
+    let h = (fov_y.to_radians() * 0.5).tan();
+    let aspect = WIDTH as f32 / HEIGHT as f32;
+    let mut rays = Vec::with_capacity((WIDTH * HEIGHT) as usize);
+    for y in 0..HEIGHT {
+        for x in 0..WIDTH {
+            let sx = (2.0 * (x as f32 + rng.next_f32()) / WIDTH as f32 - 1.0) * h * aspect;
+            let sy = (1.0 - 2.0 * (y as f32 + rng.next_f32()) / HEIGHT as f32) * h;
+            rays.push(Ray::new(eye, (forward + right * sx + up * sy).normalize()));
+        }
+    }
+    rays
+}
+
+/// Rays with origins uniform in the scene's bounding box and directions uniform on the
+/// sphere.
+fn incoherent_rays(geometry: &Geometry, count: usize, seed: u64) -> Vec<Ray> {
+    let mut rng = SplitMix(seed);
+    let b = geometry.bounds();
+    (0..count)
+        .map(|_| {
+            let o =
+                b.min + b.diagonal() * Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+            let z = 1.0 - 2.0 * rng.next_f32();
+            let phi = std::f32::consts::TAU * rng.next_f32();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            Ray::new(o, Vec3::new(r * phi.cos(), r * phi.sin(), z))
+        })
+        .collect()
+}
+
+fn trace_all(pool: &rayon::ThreadPool, geometry: &Geometry, rays: &[Ray]) -> usize {
+    pool.install(|| {
+        rays.par_chunks(CHUNK)
+            .map(|chunk| {
+                chunk
+                    .iter()
+                    .filter(|r| black_box(geometry.intersect(r)).is_some())
+                    .count()
+            })
+            .sum()
+    })
+}
+
+fn occluded_all(pool: &rayon::ThreadPool, geometry: &Geometry, rays: &[Ray]) -> usize {
+    pool.install(|| {
+        rays.par_chunks(CHUNK)
+            .map(|chunk| {
+                chunk
+                    .iter()
+                    .filter(|r| black_box(geometry.occluded(r)))
+                    .count()
+            })
+            .sum()
+    })
+}
+
+struct BenchScene {
+    name: &'static str,
+    shapes: Vec<ShapeDesc>,
+    eye: Vec3,
+    target: Vec3,
+}
+
+fn scenes() -> Vec<BenchScene> {
+    vec![
+        BenchScene {
+            name: "cornell_uvsphere_100k",
+            shapes: cornell_box_with_sphere(556.0),
+            eye: Vec3::new(278.0, 278.0, -780.0),
+            target: Vec3::new(278.0, 278.0, 278.0),
+        },
+        BenchScene {
+            name: "displaced_sphere_1m",
+            shapes: vec![mesh_shape(
+                "displaced",
+                displaced_sphere_1m(Vec3::ZERO, 1.0),
+            )],
+            eye: Vec3::new(0.4, 0.6, -3.6),
+            target: Vec3::ZERO,
+        },
+    ]
+}
+
+fn bench_rays(c: &mut Criterion) {
+    let pools: Vec<(usize, rayon::ThreadPool)> = [1, 2]
+        .into_iter()
+        .map(|n| {
+            (
+                n,
+                rayon::ThreadPoolBuilder::new()
+                    .num_threads(n)
+                    .build()
+                    .unwrap(),
+            )
+        })
+        .collect();
+    for scene in scenes() {
+        let geometry = Geometry::build(&scene.shapes);
+        let coherent = camera_rays(scene.eye, scene.target, 40.0, 1);
+        let incoherent = incoherent_rays(&geometry, coherent.len(), 2);
+        let mut group = c.benchmark_group(format!("rays/{}", scene.name));
+        group
+            .sample_size(10)
+            .warm_up_time(Duration::from_millis(500))
+            .measurement_time(Duration::from_secs(3))
+            .throughput(Throughput::Elements(coherent.len() as u64));
+        for (threads, pool) in &pools {
+            group.bench_function(format!("closest_coherent/{threads}t"), |b| {
+                b.iter(|| trace_all(pool, &geometry, &coherent))
+            });
+            group.bench_function(format!("closest_incoherent/{threads}t"), |b| {
+                b.iter(|| trace_all(pool, &geometry, &incoherent))
+            });
+        }
+        group.bench_function("anyhit_incoherent/1t", |b| {
+            b.iter(|| occluded_all(&pools[0].1, &geometry, &incoherent))
+        });
+        group.finish();
+
+        let mut group = c.benchmark_group(format!("build/{}", scene.name));
+        group
+            .sample_size(10)
+            .warm_up_time(Duration::from_millis(500))
+            .measurement_time(Duration::from_secs(5))
+            .throughput(Throughput::Elements(geometry.triangle_count() as u64));
+        group.bench_function("geometry_build", |b| {
+            b.iter(|| Geometry::build(black_box(&scene.shapes)))
+        });
+        group.finish();
+    }
+}
+
+criterion_group!(benches, bench_rays);
+criterion_main!(benches);

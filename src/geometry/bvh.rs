@@ -1,26 +1,33 @@
 //! All triangles of a scene in one compressed 8-wide BVH (Ylitie, Karras & Laine,
-//! "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", HPG 2017),
-//! built by obvhs (PLOC + reinsertion, then collapsed to CWBVH).
+//! "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", HPG 2017):
+//! obvhs builds a binary BVH (PLOC + reinsertion, in parallel), `cwbvh.rs` collapses it
+//! into obvhs's `CwBvhNode` layout.
 //!
 //! The traversal is mltbench's own, so that it can be conservative: obvhs's node test
 //! drops boxes closer than t = 1e-4 and has no rounding slack, which loses hits near ray
 //! origins and lets rays slip past box faces. Here each slab distance is widened by a bound
-//! on its rounding error (and on the builder's quantisation rounding), so a triangle that
-//! the exact ray meets is never culled by a box test; the triangle test is watertight
-//! (`triangle.rs`). Triangle data are stored in the BVH's leaf order: a leaf's triangles
-//! are contiguous and need no index indirection.
+//! on its rounding error, so a triangle that the exact ray meets is never culled by a box
+//! test; the triangle test is watertight (`triangle.rs`). Triangle data are stored in the
+//! BVH's leaf order: a leaf's triangles are contiguous and need no index indirection.
+//!
+//! Measured on the development machine (2-core AMD EPYC, AVX2): obvhs's CWBVH traversal ran
+//! 1.5–2.5× faster than its binary BVH traversal with the same triangle test, so only the
+//! wide tree is kept.
 
 use glam::{UVec2, Vec2, Vec3, Vec3A, uvec2};
 use obvhs::{
-    BvhBuildParams, bvh2::reinsertion::ReinsertionOptimizer, cwbvh::bvh2_to_cwbvh::bvh2_to_cwbvh,
-    cwbvh::node::CwBvhNode, ploc::PlocBuilder, triangle::Triangle,
+    BvhBuildParams, aabb::Aabb, bvh2::reinsertion::ReinsertionOptimizer, cwbvh::node::CwBvhNode,
+    ploc::PlocBuilder,
 };
+use rayon::prelude::*;
 
+use super::cwbvh;
 use super::offset::gamma;
 use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord};
 
-/// Build settings: obvhs's `fast_build` preset (measured against the others in the
-/// README's geometry section: best traversal for the build time).
+/// Binary BVH settings: obvhs's `fast_build` preset (PLOC with a short search radius and a
+/// little reinsertion). Measured against `very_fast_build` (not faster to build here) and
+/// `medium_build` (slower to build, no faster to traverse after the 8-wide collapse).
 pub fn build_params() -> BvhBuildParams {
     BvhBuildParams::fast_build()
 }
@@ -42,8 +49,27 @@ pub struct TraversalRay {
     pub tri: TriangleRay,
 }
 
+// The near/far plane selection below relies on each axis' max planes following its min
+// planes.
+const _: () = {
+    assert!(
+        std::mem::offset_of!(CwBvhNode, child_max_x)
+            == std::mem::offset_of!(CwBvhNode, child_min_x) + 8
+    );
+    assert!(
+        std::mem::offset_of!(CwBvhNode, child_max_y)
+            == std::mem::offset_of!(CwBvhNode, child_min_y) + 8
+    );
+    assert!(
+        std::mem::offset_of!(CwBvhNode, child_max_z)
+            == std::mem::offset_of!(CwBvhNode, child_min_z) + 8
+    );
+};
+
 impl TraversalRay {
-    /// `d` must be finite and of unit length (up to rounding).
+    /// `d` must be finite and non-zero (`Geometry` scales it so that its largest component
+    /// is in [1, 2)).
+    #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Self {
         // A zero (or tiny) component would give an infinite reciprocal and NaN slab
         // distances (0·∞); 1e-18 keeps them finite, and the resulting tilt (≤ 1e-18 per
@@ -56,29 +82,25 @@ impl TraversalRay {
             }
         };
         let dc = Vec3A::new(clamp(d.x), clamp(d.y), clamp(d.z));
-        let offsets = [
-            (
-                std::mem::offset_of!(CwBvhNode, child_min_x),
-                std::mem::offset_of!(CwBvhNode, child_max_x),
-            ),
-            (
-                std::mem::offset_of!(CwBvhNode, child_min_y),
-                std::mem::offset_of!(CwBvhNode, child_max_y),
-            ),
-            (
-                std::mem::offset_of!(CwBvhNode, child_min_z),
-                std::mem::offset_of!(CwBvhNode, child_max_z),
-            ),
+        // Arithmetic instead of branches (directions are random): a negative component
+        // swaps the axis' near and far planes, and clears its octant bit.
+        // Signs from the clamped components: a −0 component became −1e-18, and the plane
+        // choice must agree with the sign of its reciprocal.
+        let neg = [
+            (dc.x < 0.0) as usize,
+            (dc.y < 0.0) as usize,
+            (dc.z < 0.0) as usize,
         ];
-        let mut near = [0; 3];
-        let mut far = [0; 3];
-        for k in 0..3 {
-            let (lo, hi) = offsets[k];
-            (near[k], far[k]) = if dc[k] < 0.0 { (hi, lo) } else { (lo, hi) };
-        }
-        let oct_inv4 = (if d.x < 0.0 { 0 } else { 0x0404_0404 })
-            | (if d.y < 0.0 { 0 } else { 0x0202_0202 })
-            | (if d.z < 0.0 { 0 } else { 0x0101_0101 });
+        let min = [
+            std::mem::offset_of!(CwBvhNode, child_min_x),
+            std::mem::offset_of!(CwBvhNode, child_min_y),
+            std::mem::offset_of!(CwBvhNode, child_min_z),
+        ];
+        let near = [0, 1, 2].map(|k| min[k] + 8 * neg[k]);
+        let far = [0, 1, 2].map(|k| min[k] + 8 * (1 - neg[k]));
+        let oct_inv4 = ((1 - neg[0] as u32) * 0x0404_0404)
+            | ((1 - neg[1] as u32) * 0x0202_0202)
+            | ((1 - neg[2] as u32) * 0x0101_0101);
         TraversalRay {
             o: o.into(),
             d: d.into(),
@@ -91,19 +113,23 @@ impl TraversalRay {
     }
 }
 
-/// What `TriangleBvh::build` needs per triangle. Vertex normals and uvs are optional per
-/// triangle (`None`: the mesh has none); they are stored in leaf order too, so the closest
-/// hit reads them from one place instead of chasing mesh indices.
-pub struct TriangleInput<'a> {
-    pub vertices: &'a [[Vec3; 3]],
-    /// (shape, primitive) of each triangle.
-    pub ids: &'a [[u32; 2]],
-    pub normals: Option<&'a [Option<[Vec3; 3]>]>,
-    pub uvs: Option<&'a [Option<[Vec2; 3]>]>,
+/// Where `TriangleBvh::build` reads its triangles from: `triangle_count()` triangles, each with its
+/// vertices, identity and optional vertex attributes. The attributes are stored in leaf
+/// order too, so that the closest hit reads them from one place instead of chasing mesh
+/// indices.
+pub trait TriangleSource: Sync {
+    fn triangle_count(&self) -> usize;
+    fn vertices(&self, i: usize) -> [Vec3; 3];
+    /// (shape, primitive).
+    fn ids(&self, i: usize) -> [u32; 2];
+    /// Whether any triangle has vertex normals (if none has, none are stored).
+    fn has_normals(&self) -> bool;
+    fn normals(&self, i: usize) -> Option<[Vec3; 3]>;
+    fn has_uvs(&self) -> bool;
+    fn uvs(&self, i: usize) -> Option<[Vec2; 3]>;
 }
 
 /// The BVH and the triangles in its leaf order.
-#[derive(Default)]
 pub struct TriangleBvh {
     nodes: Vec<CwBvhNode>,
     records: Vec<TriangleRecord>,
@@ -112,65 +138,70 @@ pub struct TriangleBvh {
     /// Vertex uvs per record (NaN when the mesh has none), if any mesh has them.
     uvs: Option<Vec<[Vec2; 3]>>,
     depth: usize,
+    bounds: (Vec3, Vec3),
 }
 
 impl TriangleBvh {
-    pub fn build(input: &TriangleInput) -> TriangleBvh {
-        let triangles = input.vertices;
-        if triangles.is_empty() {
+    /// Builds the BVH: triangle boxes, PLOC and reinsertion (obvhs), then the 8-wide
+    /// collapse (`cwbvh.rs`) and the triangle data in leaf order; the independent steps run
+    /// on rayon's threads.
+    pub fn build(source: &impl TriangleSource) -> TriangleBvh {
+        let n = source.triangle_count();
+        if n == 0 {
             return TriangleBvh::default();
         }
         let params = build_params();
-        let aabbs: Vec<obvhs::aabb::Aabb> = triangles
-            .iter()
-            .map(|t| {
-                Triangle {
-                    v0: t[0].into(),
-                    v1: t[1].into(),
-                    v2: t[2].into(),
-                }
-                .aabb()
+        let aabbs: Vec<Aabb> = (0..n)
+            .into_par_iter()
+            .map(|i| {
+                let [a, b, c] = source.vertices(i).map(Vec3A::from);
+                Aabb::new(a.min(b).min(c), a.max(b).max(c))
             })
             .collect();
-        let mut bvh2 = PlocBuilder::with_capacity(aabbs.len()).build(
+        let mut bvh2 = PlocBuilder::with_capacity(n).build(
             params.ploc_search_distance,
             &aabbs,
-            (0..aabbs.len() as u32).collect(),
+            (0..n as u32).collect(),
             params.sort_precision,
             params.search_depth_threshold,
         );
         drop(aabbs);
         ReinsertionOptimizer::default().run(&mut bvh2, params.reinsertion_batch_ratio, None);
-        let cwbvh = bvh2_to_cwbvh(&bvh2, params.max_prims_per_leaf.clamp(1, 3), true, false);
+        let root = *bvh2.nodes[0].aabb();
+        let wide = cwbvh::collapse(&bvh2);
         drop(bvh2);
-        let order = &cwbvh.primitive_indices;
-        let records = order
-            .iter()
-            .map(|&i| {
-                let [shape, primitive] = input.ids[i as usize];
-                TriangleRecord::new(triangles[i as usize], shape, primitive)
-            })
-            .collect();
-        let normals = input.normals.map(|n| {
+        let order = &wide.primitive_order;
+        let records = collect_large(order.par_iter().map(|&i| {
+            let [shape, primitive] = source.ids(i as usize);
+            TriangleRecord::new(source.vertices(i as usize), shape, primitive)
+        }));
+        // Read once per closest hit (and prefetched): ordinary pages.
+        let normals = source.has_normals().then(|| {
             order
-                .iter()
-                .map(|&i| n[i as usize].unwrap_or([Vec3::ZERO; 3]))
+                .par_iter()
+                .map(|&i| source.normals(i as usize).unwrap_or([Vec3::ZERO; 3]))
                 .collect()
         });
-        let uvs = input.uvs.map(|uv| {
+        let uvs = source.has_uvs().then(|| {
             order
-                .iter()
-                .map(|&i| uv[i as usize].unwrap_or([Vec2::NAN; 3]))
+                .par_iter()
+                .map(|&i| source.uvs(i as usize).unwrap_or([Vec2::NAN; 3]))
                 .collect()
         });
-        let depth = depth(&cwbvh.nodes, 0);
+        let nodes = collect_large(wide.nodes.par_iter().copied());
         TriangleBvh {
-            nodes: cwbvh.nodes,
+            nodes,
             records,
             normals,
             uvs,
-            depth,
+            depth: wide.depth,
+            bounds: (root.min.into(), root.max.into()),
         }
+    }
+
+    /// The box around all triangles (min, max); empty (+∞, −∞) without triangles.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
     }
 
     pub fn record(&self, index: u32) -> &TriangleRecord {
@@ -193,44 +224,33 @@ impl TriangleBvh {
         self.nodes.len()
     }
 
-    /// Closest triangle with 0 < t < t_max: (record index, t).
-    pub fn closest(&self, ray: &TraversalRay, t_max: f32) -> Option<(u32, f32)> {
+    /// Closest triangle with 0 < t < t_max: (record index, its hit data).
+    pub fn closest(&self, ray: &TraversalRay, t_max: f32) -> Option<(u32, TriangleHit)> {
         if self.nodes.is_empty() {
             return None;
         }
-        let mut best = None;
-        let mut t_max = t_max;
-        let visit = |id: u32, t_max: &mut f32| {
-            if let Some(h) = triangle::intersect(&self.records[id as usize], &ray.tri, *t_max) {
-                *t_max = h.t;
-                best = Some(id);
-                // The surface data of the closest hit will be read from these: start
-                // fetching them while traversal goes on.
-                if let Some(n) = &self.normals {
-                    prefetch(&n[id as usize]);
-                }
-                if let Some(uv) = &self.uvs {
-                    prefetch(&uv[id as usize]);
-                }
-            }
-            false
+        let mut visitor = Closest {
+            bvh: self,
+            ray,
+            best: None,
         };
+        let mut t_max = t_max;
         if self.depth < FIXED_STACK {
             self.traverse(
                 ray,
                 &mut t_max,
                 &mut FixedStack::<FIXED_STACK>::new(),
-                visit,
+                &mut visitor,
             );
         } else {
             self.traverse(
                 ray,
                 &mut t_max,
                 &mut Vec::with_capacity(self.depth + 1),
-                visit,
+                &mut visitor,
             );
         }
-        best.map(|id| (id, t_max))
+        visitor.best
     }
 
     /// True when some triangle lies at 0 < t < t_max.
@@ -238,30 +258,23 @@ impl TriangleBvh {
         if self.nodes.is_empty() {
             return false;
         }
+        let mut visitor = Any { bvh: self, ray };
         let mut t_max = t_max;
-        let visit = |id: u32, t_max: &mut f32| {
-            triangle::intersect(&self.records[id as usize], &ray.tri, *t_max).is_some()
-        };
         if self.depth < FIXED_STACK {
             self.traverse(
                 ray,
                 &mut t_max,
                 &mut FixedStack::<FIXED_STACK>::new(),
-                visit,
+                &mut visitor,
             )
         } else {
             self.traverse(
                 ray,
                 &mut t_max,
                 &mut Vec::with_capacity(self.depth + 1),
-                visit,
+                &mut visitor,
             )
         }
-    }
-
-    /// The hit data of record `index` for `ray` (the same test as during traversal).
-    pub fn hit(&self, index: u32, ray: &TraversalRay) -> Option<TriangleHit> {
-        triangle::intersect(&self.records[index as usize], &ray.tri, f32::INFINITY)
     }
 
     /// Walks the BVH front to back (Ylitie et al. 2017, Algorithm 1: node groups hold the
@@ -274,7 +287,7 @@ impl TriangleBvh {
         ray: &TraversalRay,
         t_max: &mut f32,
         stack: &mut S,
-        mut visit: impl FnMut(u32, &mut f32) -> bool,
+        visitor: &mut impl Visitor,
     ) -> bool {
         let oct = ray.oct_inv4 & 0xff;
         // The root alone in a group: child base 0, one hit bit in slot 7 ^ oct's place.
@@ -297,13 +310,14 @@ impl TriangleBvh {
                     (hitmask & 0xff00_0000) | node.imask as u32,
                 );
                 tri_group = uvec2(node.primitive_base_idx, hitmask & 0x00ff_ffff);
+                self.prefetch_children(node, hitmask, oct);
             } else {
                 node_group = UVec2::ZERO;
             }
             while tri_group.y != 0 {
                 let bit = tri_group.y.trailing_zeros();
                 tri_group.y &= tri_group.y - 1;
-                if visit(tri_group.x + bit, t_max) {
+                if visitor.visit(tri_group.x + bit, t_max) {
                     return true;
                 }
             }
@@ -317,15 +331,160 @@ impl TriangleBvh {
     }
 }
 
-/// Depth of the CWBVH below `node` (1 for a node whose children are all leaves).
-fn depth(nodes: &[CwBvhNode], node: usize) -> usize {
-    let n = &nodes[node];
-    1 + (0..8)
-        .filter(|&c| !n.is_child_empty(c) && !n.is_leaf(c))
-        .map(|c| depth(nodes, n.child_node_index(c) as usize))
-        .max()
-        .unwrap_or(0)
+impl TriangleBvh {
+    /// Starts loading the hit children of `node` (internal nodes and leaf triangles) so that
+    /// their cache misses overlap instead of following one another.
+    #[inline(always)]
+    fn prefetch_children(&self, node: &CwBvhNode, hitmask: u32, oct: u32) {
+        let mut internal = hitmask >> 24;
+        while internal != 0 {
+            let slot = internal.trailing_zeros() ^ oct;
+            internal &= internal - 1;
+            let rank = (node.imask as u32 & !(u32::MAX << slot)).count_ones();
+            if let Some(child) = self.nodes.get((node.child_base_idx + rank) as usize) {
+                prefetch(child);
+                prefetch(&child.child_max_z); // the node's second cache line
+            }
+        }
+        let tris = hitmask & 0x00ff_ffff;
+        if tris != 0 {
+            let first = node.primitive_base_idx + tris.trailing_zeros();
+            let last = node.primitive_base_idx + 31 - tris.leading_zeros();
+            for id in first..=last {
+                if let Some(r) = self.records.get(id as usize) {
+                    prefetch(r);
+                }
+            }
+        }
+    }
 }
+
+/// What traversal does with each triangle of a hit leaf.
+trait Visitor {
+    /// Tests record `id`, may lower `t_max`; true stops the traversal.
+    fn visit(&mut self, id: u32, t_max: &mut f32) -> bool;
+}
+
+/// Closest hit: keep the nearest, shrink the segment to it.
+struct Closest<'a> {
+    bvh: &'a TriangleBvh,
+    ray: &'a TraversalRay,
+    best: Option<(u32, TriangleHit)>,
+}
+
+impl Visitor for Closest<'_> {
+    #[inline(always)]
+    fn visit(&mut self, id: u32, t_max: &mut f32) -> bool {
+        if let Some(h) = triangle::intersect(&self.bvh.records[id as usize], &self.ray.tri, *t_max)
+        {
+            *t_max = h.t;
+            self.best = Some((id, h));
+            // The surface data of the closest hit will be read from these: start fetching
+            // them while traversal goes on.
+            if let Some(n) = &self.bvh.normals {
+                prefetch(&n[id as usize]);
+            }
+            if let Some(uv) = &self.bvh.uvs {
+                prefetch(&uv[id as usize]);
+            }
+        }
+        false
+    }
+}
+
+/// Any hit: stop at the first.
+struct Any<'a> {
+    bvh: &'a TriangleBvh,
+    ray: &'a TraversalRay,
+}
+
+impl Visitor for Any<'_> {
+    #[inline(always)]
+    fn visit(&mut self, id: u32, t_max: &mut f32) -> bool {
+        triangle::intersect(&self.bvh.records[id as usize], &self.ray.tri, *t_max).is_some()
+    }
+}
+
+/// Plain triangles without vertex attributes.
+pub struct TriangleList<'a> {
+    pub vertices: &'a [[Vec3; 3]],
+    pub ids: &'a [[u32; 2]],
+}
+
+impl TriangleSource for TriangleList<'_> {
+    fn triangle_count(&self) -> usize {
+        self.vertices.len()
+    }
+    fn vertices(&self, i: usize) -> [Vec3; 3] {
+        self.vertices[i]
+    }
+    fn ids(&self, i: usize) -> [u32; 2] {
+        self.ids[i]
+    }
+    fn has_normals(&self) -> bool {
+        false
+    }
+    fn normals(&self, _: usize) -> Option<[Vec3; 3]> {
+        None
+    }
+    fn has_uvs(&self) -> bool {
+        false
+    }
+    fn uvs(&self, _: usize) -> Option<[Vec2; 3]> {
+        None
+    }
+}
+
+impl Default for TriangleBvh {
+    fn default() -> Self {
+        TriangleBvh {
+            nodes: Vec::new(),
+            records: Vec::new(),
+            normals: None,
+            uvs: None,
+            depth: 0,
+            bounds: (Vec3::INFINITY, Vec3::NEG_INFINITY),
+        }
+    }
+}
+
+/// Collects a large array that traversal reads at random. On Linux, the allocation is
+/// first marked for transparent huge pages (2 MiB): random reads over tens of megabytes
+/// miss the TLB on nearly every access with 4 KiB pages (measured on the development
+/// machine: 250 ns → 160 ns per dependent random read over 64 MiB).
+fn collect_large<T: Send>(items: impl IndexedParallelIterator<Item = T>) -> Vec<T> {
+    let mut v = Vec::with_capacity(items.len());
+    advise_huge_pages(&v);
+    v.par_extend(items);
+    v
+}
+
+#[cfg(target_os = "linux")]
+fn advise_huge_pages<T>(v: &Vec<T>) {
+    let bytes = v.capacity() * std::mem::size_of::<T>();
+    if bytes < 4 << 20 {
+        return;
+    }
+    const PAGE: usize = 4096;
+    let start = v.as_ptr() as usize;
+    let aligned = (start + PAGE - 1) & !(PAGE - 1);
+    let end = start + bytes;
+    if end > aligned {
+        // SAFETY: the range lies inside the vector's (still untouched) allocation;
+        // MADV_HUGEPAGE only changes how the kernel backs those pages, never their contents.
+        // Failure (e.g. THP disabled) just leaves ordinary pages.
+        unsafe {
+            libc::madvise(
+                aligned as *mut libc::c_void,
+                end - aligned,
+                libc::MADV_HUGEPAGE,
+            );
+        }
+    }
+}
+
+#[cfg(not(target_os = "linux"))]
+fn advise_huge_pages<T>(_: &Vec<T>) {}
 
 /// Hint the CPU to bring `*v`'s cache line in (no effect on results).
 #[inline(always)]
@@ -392,10 +551,10 @@ impl TraversalStack for Vec<UVec2> {
 /// Per-node slab constants. A child plane with quantised coordinate q lies at
 /// x = p + q·e (e a power of two), at ray distance t = q·a + b with a = e/d and
 /// b = (p − o)/d. Rounding: 1/d (one rounding), p − o and the product (two), q·a (exact e,
-/// one), the fused sum (one): |Δt| ≤ γ(4)·(|b| + q|a|). The builder's quantisation rounds
-/// (child.min − p)/e once before flooring, so a plane may sit up to u·256·e inside the
-/// true box: 256·u·|a| more. `margin` = γ(8)·(|b| + 256|a|) covers both with room to spare;
-/// near planes move nearer by it, far planes farther.
+/// one), the fused sum (one): |Δt| ≤ γ(4)·(|b| + q|a|) ≤ γ(4)·(|b| + 255|a|). The boxes
+/// themselves are exact (`cwbvh.rs` quantises outward in f64). `margin` =
+/// γ(8)·(|b| + 256|a|) covers the rounding twice over; near planes move nearer by it, far
+/// planes farther.
 #[inline(always)]
 fn slab_constants(node: &CwBvhNode, ray: &TraversalRay) -> (Vec3A, Vec3A, Vec3A) {
     let e = Vec3A::new(
@@ -524,11 +683,9 @@ mod tests {
             tris.push([v(c, &mut next), v(c, &mut next), v(c, &mut next)]);
         }
         let ids: Vec<[u32; 2]> = (0..tris.len() as u32).map(|i| [0, i]).collect();
-        let bvh = TriangleBvh::build(&TriangleInput {
+        let bvh = TriangleBvh::build(&TriangleList {
             vertices: &tris,
             ids: &ids,
-            normals: None,
-            uvs: None,
         });
         for _ in 0..2000 {
             let o = Vec3::new(next(), next(), next()) * 12.0 - 1.0;
@@ -541,6 +698,33 @@ mod tests {
                     child_mask_scalar(node, &r, t_max)
                 );
             }
+        }
+    }
+
+    #[test]
+    fn axis_aligned_rays_with_signed_zeros_hit() {
+        // −0 direction components must pick planes consistent with their reciprocal's sign.
+        let tris = [
+            [Vec3::ZERO, Vec3::X, Vec3::Y],
+            [Vec3::Z, Vec3::Z + Vec3::X, Vec3::Z + Vec3::Y],
+        ];
+        let ids = [[0, 0], [0, 1]];
+        let bvh = TriangleBvh::build(&TriangleList {
+            vertices: &tris,
+            ids: &ids,
+        });
+        for (o, d, expected) in [
+            (Vec3::new(0.2, 0.2, 2.0), -Vec3::Z, 1),
+            (Vec3::new(0.2, 0.2, 2.0), Vec3::new(0.0, -0.0, -1.0), 1),
+            (Vec3::new(0.2, 0.2, -1.0), Vec3::new(-0.0, -0.0, 1.0), 0),
+            (Vec3::new(0.2, 0.2, 0.5), Vec3::new(-0.0, 0.0, -1.0), 0),
+        ] {
+            let hit = bvh.closest(&TraversalRay::new(o, d), f32::INFINITY);
+            assert_eq!(
+                hit.map(|(id, _)| bvh.record(id).ids()[1]),
+                Some(expected),
+                "{o} {d}"
+            );
         }
     }
 }

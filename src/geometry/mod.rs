@@ -16,6 +16,7 @@
 //! `ng` when the mesh has none.
 
 pub mod bvh;
+pub mod cwbvh;
 pub mod disk;
 pub mod offset;
 pub mod procedural;
@@ -25,12 +26,14 @@ pub mod triangle;
 use glam::{Vec2, Vec3};
 
 use crate::math::Frame;
-use crate::scene::{ShapeDesc, ShapeGeometry};
+use crate::scene::{ShapeDesc, ShapeGeometry, TriangleMesh};
+use rayon::prelude::*;
 
-use bvh::{TraversalRay, TriangleBvh, TriangleInput};
+use bvh::{TraversalRay, TriangleBvh, TriangleSource};
 use disk::Disk;
 use offset::offset_ray_origin;
 use sphere::Sphere;
+use triangle::TriangleHit;
 
 /// A ray segment: points o + t·d for t in (0, t_max). Origins are already offset off
 /// surfaces by `SurfaceInteraction::spawn_ray*`, so no epsilon is needed at t = 0.
@@ -169,6 +172,7 @@ impl Bounds3 {
 enum Hit {
     Triangle {
         record: u32,
+        hit: TriangleHit,
     },
     Sphere {
         index: usize,
@@ -229,24 +233,7 @@ impl Geometry {
     /// analytic shapes with invalid parameters are skipped (counted, see `skipped()`):
     /// the scene loader reports such input; here it must simply not break the tracer.
     pub fn build(shapes: &[ShapeDesc]) -> Geometry {
-        let mut triangles = Vec::new();
-        let mut ids = Vec::new();
-        // Per-triangle vertex attributes, gathered only if some mesh has them.
-        let valid_len = |m: &crate::scene::TriangleMesh, len: Option<usize>| {
-            len.is_some_and(|l| l == m.positions.len())
-        };
-        let meshes = shapes.iter().filter_map(|s| match &s.geometry {
-            ShapeGeometry::Mesh(m) => Some(m),
-            _ => None,
-        });
-        let any_normals = meshes
-            .clone()
-            .any(|m| valid_len(m, m.normals.as_ref().map(Vec::len)));
-        let any_uvs = meshes
-            .clone()
-            .any(|m| valid_len(m, m.uvs.as_ref().map(Vec::len)));
-        let mut normals = Vec::new();
-        let mut uvs = Vec::new();
+        let mut ids: Vec<[u32; 2]> = Vec::new();
         let mut spheres = Vec::new();
         let mut disks = Vec::new();
         let mut bounds = Bounds3::EMPTY;
@@ -256,32 +243,11 @@ impl Geometry {
             let si = si as u32;
             match &shape.geometry {
                 ShapeGeometry::Mesh(mesh) => {
-                    let n = mesh.positions.len();
-                    let mesh_normals = mesh.normals.as_ref().filter(|v| v.len() == n);
-                    let mesh_uvs = mesh.uvs.as_ref().filter(|v| v.len() == n);
-                    for (pi, idx) in mesh.indices.iter().enumerate() {
-                        if idx.iter().any(|&i| i as usize >= n) {
-                            skipped_triangles += 1;
-                            continue;
-                        }
-                        let v = idx.map(|i| mesh.positions[i as usize]);
-                        let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
-                        if !(v.iter().all(|p| p.is_finite()) && ng.is_finite()) {
-                            skipped_triangles += 1;
-                            continue;
-                        }
-                        for p in v {
-                            bounds = bounds.with_point(p);
-                        }
-                        triangles.push(v);
-                        ids.push([si, pi as u32]);
-                        if any_normals {
-                            normals.push(mesh_normals.map(|n| idx.map(|i| n[i as usize])));
-                        }
-                        if any_uvs {
-                            uvs.push(mesh_uvs.map(|uv| idx.map(|i| uv[i as usize])));
-                        }
-                    }
+                    let before = ids.len();
+                    ids.par_extend(mesh.indices.par_iter().enumerate().filter_map(|(pi, idx)| {
+                        triangle_is_usable(mesh, idx).then_some([si, pi as u32])
+                    }));
+                    skipped_triangles += mesh.indices.len() - (ids.len() - before);
                 }
                 ShapeGeometry::Sphere { center, radius } => {
                     let s = Sphere {
@@ -310,19 +276,17 @@ impl Geometry {
                 }
             }
         }
-        let triangle_count = triangles.len();
-        let bvh = TriangleBvh::build(&TriangleInput {
-            vertices: &triangles,
-            ids: &ids,
-            normals: any_normals.then_some(normals.as_slice()),
-            uvs: any_uvs.then_some(uvs.as_slice()),
-        });
+        let bvh = TriangleBvh::build(&MeshSource::new(shapes, &ids));
+        if !ids.is_empty() {
+            let (lo, hi) = bvh.bounds();
+            bounds = bounds.with_point(lo).with_point(hi);
+        }
         Geometry {
             bvh,
             spheres,
             disks,
             bounds,
-            triangle_count,
+            triangle_count: ids.len(),
             skipped_shapes,
             skipped_triangles,
         }
@@ -366,11 +330,11 @@ impl Geometry {
         } else {
             r.t_max
         };
-        if let Some((record, _)) = self.bvh.closest(&traversal, t_max) {
-            hit = Some(Hit::Triangle { record });
+        if let Some((record, h)) = self.bvh.closest(&traversal, t_max) {
+            hit = Some(Hit::Triangle { record, hit: h });
         }
         match hit? {
-            Hit::Triangle { record } => self.triangle_interaction(record, &traversal, r.scale),
+            Hit::Triangle { record, hit } => Some(self.triangle_interaction(record, &hit, r.scale)),
             Hit::Sphere { index, t } => {
                 let s = &self.spheres[index];
                 let h = s.hit(r.o, r.d, t);
@@ -422,13 +386,7 @@ impl Geometry {
         self.bvh.any(&TraversalRay::new(r.o, r.d), r.t_max)
     }
 
-    fn triangle_interaction(
-        &self,
-        record: u32,
-        ray: &TraversalRay,
-        scale: f32,
-    ) -> Option<SurfaceInteraction> {
-        let h = self.bvh.hit(record, ray)?;
+    fn triangle_interaction(&self, record: u32, h: &TriangleHit, scale: f32) -> SurfaceInteraction {
         let rec = self.bvh.record(record);
         let v = [rec.vertex(0), rec.vertex(1), rec.vertex(2)];
         let b = h.barycentrics();
@@ -446,16 +404,104 @@ impl Geometry {
             .uvs(record)
             .map(|uv| uv[0] * b[0] + uv[1] * b[1] + uv[2] * b[2])
             .unwrap_or(Vec2::new(b[1], b[2]));
-        Some(interaction(
-            p,
-            p_error,
-            h.t / scale,
-            ng,
-            ns,
-            uv,
-            shape,
-            primitive,
-        ))
+        interaction(p, p_error, h.t / scale, ng, ns, uv, shape, primitive)
+    }
+}
+
+/// Whether a mesh triangle can be intersected: indices in range, finite vertices, and a
+/// normal that normalises (non-zero area).
+fn triangle_is_usable(mesh: &TriangleMesh, idx: &[u32; 3]) -> bool {
+    if idx.iter().any(|&i| i as usize >= mesh.positions.len()) {
+        return false;
+    }
+    let v = idx.map(|i| mesh.positions[i as usize]);
+    v.iter().all(|p| p.is_finite()) && (v[1] - v[0]).cross(v[2] - v[0]).normalize().is_finite()
+}
+
+/// The scene's mesh triangles as the BVH builder reads them.
+struct MeshSource<'a> {
+    /// Per shape: the mesh, with its normals and uvs when they have one entry per vertex.
+    meshes: Vec<Option<MeshView<'a>>>,
+    ids: &'a [[u32; 2]],
+    has_normals: bool,
+    has_uvs: bool,
+}
+
+struct MeshView<'a> {
+    mesh: &'a TriangleMesh,
+    normals: Option<&'a [Vec3]>,
+    uvs: Option<&'a [Vec2]>,
+}
+
+impl<'a> MeshSource<'a> {
+    fn new(shapes: &'a [ShapeDesc], ids: &'a [[u32; 2]]) -> Self {
+        let meshes: Vec<Option<MeshView>> = shapes
+            .iter()
+            .map(|s| match &s.geometry {
+                ShapeGeometry::Mesh(mesh) => {
+                    let n = mesh.positions.len();
+                    Some(MeshView {
+                        mesh,
+                        normals: mesh.normals.as_deref().filter(|v| v.len() == n),
+                        uvs: mesh.uvs.as_deref().filter(|v| v.len() == n),
+                    })
+                }
+                _ => None,
+            })
+            .collect();
+        let has_normals = meshes.iter().flatten().any(|m| m.normals.is_some());
+        let has_uvs = meshes.iter().flatten().any(|m| m.uvs.is_some());
+        MeshSource {
+            meshes,
+            ids,
+            has_normals,
+            has_uvs,
+        }
+    }
+
+    /// The mesh and vertex indices of triangle i.
+    fn triangle(&self, i: usize) -> (&MeshView<'a>, [usize; 3]) {
+        let [shape, primitive] = self.ids[i];
+        let view = self.meshes[shape as usize]
+            .as_ref()
+            .expect("triangle ids name mesh shapes");
+        (
+            view,
+            view.mesh.indices[primitive as usize].map(|j| j as usize),
+        )
+    }
+}
+
+impl TriangleSource for MeshSource<'_> {
+    fn triangle_count(&self) -> usize {
+        self.ids.len()
+    }
+
+    fn vertices(&self, i: usize) -> [Vec3; 3] {
+        let (view, idx) = self.triangle(i);
+        idx.map(|j| view.mesh.positions[j])
+    }
+
+    fn ids(&self, i: usize) -> [u32; 2] {
+        self.ids[i]
+    }
+
+    fn has_normals(&self) -> bool {
+        self.has_normals
+    }
+
+    fn normals(&self, i: usize) -> Option<[Vec3; 3]> {
+        let (view, idx) = self.triangle(i);
+        view.normals.map(|n| idx.map(|j| n[j]))
+    }
+
+    fn has_uvs(&self) -> bool {
+        self.has_uvs
+    }
+
+    fn uvs(&self, i: usize) -> Option<[Vec2; 3]> {
+        let (view, idx) = self.triangle(i);
+        view.uvs.map(|uv| idx.map(|j| uv[j]))
     }
 }
 

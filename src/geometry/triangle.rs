@@ -86,30 +86,30 @@ pub struct TriangleRay {
 
 impl TriangleRay {
     /// `d` must be non-zero and finite.
+    #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Self {
-        let a = d.abs();
-        let kz = if a.x >= a.y && a.x >= a.z {
-            0
-        } else if a.y >= a.z {
-            1
-        } else {
-            2
-        };
-        let mut kx = (kz + 1) % 3;
-        let mut ky = (kx + 1) % 3;
-        if d[kz] < 0.0 {
+        // Written with array lookups and selects rather than branches: ray directions are
+        // random, branches on them mispredict.
+        const NEXT: [usize; 3] = [1, 2, 0];
+        let (oa, da) = (o.to_array(), d.to_array());
+        let a = d.abs().to_array();
+        let mut kz = if a[1] > a[0] { 1 } else { 0 };
+        kz = if a[2] > a[kz] { 2 } else { kz };
+        let (mut kx, mut ky) = (NEXT[kz], NEXT[NEXT[kz]]);
+        if da[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
+        let sz = 1.0 / da[kz];
         TriangleRay {
             kx,
             ky,
             kz,
-            ox: o[kx],
-            oy: o[ky],
-            oz: o[kz],
-            sx: d[kx] / d[kz],
-            sy: d[ky] / d[kz],
-            sz: 1.0 / d[kz],
+            ox: oa[kx],
+            oy: oa[ky],
+            oz: oa[kz],
+            sx: da[kx] * sz,
+            sy: da[ky] * sz,
+            sz,
             o,
             d,
         }
@@ -128,11 +128,8 @@ pub struct TriangleHit {
 impl TriangleHit {
     /// Barycentrics (b0, b1, b2) of the hit: non-negative, summing to one up to rounding.
     pub fn barycentrics(&self) -> [f32; 3] {
-        [
-            self.e[0] / self.det,
-            self.e[1] / self.det,
-            self.e[2] / self.det,
-        ]
+        let inv = 1.0 / self.det;
+        [self.e[0] * inv, self.e[1] * inv, self.e[2] * inv]
     }
 }
 
@@ -327,14 +324,14 @@ pub fn intersect(tri: &TriangleRecord, r: &TriangleRay, t_max: f32) -> Option<Tr
 /// Take as the exact surface point the convex combination with the exact normalised
 /// barycentrics b_i = e_i / Σ e_j of the computed edge functions (non-negative, so it lies on
 /// the triangle; whether it is exactly the ray's hit does not matter for offsetting). The
-/// computed b̂_i went through the sum (two roundings, same-sign terms) and a division: within
-/// γ(3) of b_i relatively. The sum Σ b̂_i·v_i adds three rounded products: γ(3)·Σ|b̂_i v_i|
-/// more. So |p̂ − p| ≤ γ(3)·Σ|b_i v_i| + γ(3)·Σ|b̂_i v_i| ≤ γ(7)·Σ|b̂_i v_i| per coordinate;
-/// γ(8) leaves room for replacing b by b̂ in the bound.
+/// computed b̂_i went through the sum (two roundings, same-sign terms), a reciprocal and a
+/// product: within γ(4) of b_i relatively. The sum Σ b̂_i·v_i adds three rounded products: γ(3)·Σ|b̂_i v_i|
+/// more. So |p̂ − p| ≤ γ(4)·Σ|b_i v_i| + γ(3)·Σ|b̂_i v_i| ≤ γ(8)·Σ|b̂_i v_i| per coordinate;
+/// γ(9) leaves room for replacing b by b̂ in the bound.
 pub fn hit_point(v: [Vec3; 3], b: [f32; 3]) -> (Vec3, Vec3) {
     let p = v[0] * b[0] + v[1] * b[1] + v[2] * b[2];
     let sum_abs = (v[0] * b[0]).abs() + (v[1] * b[1]).abs() + (v[2] * b[2]).abs();
-    (p, sum_abs * gamma(8))
+    (p, sum_abs * gamma(9))
 }
 
 #[cfg(test)]
