@@ -754,3 +754,41 @@ fn spawned_rays_do_not_self_intersect() {
     eprintln!("{}", report.join("\n"));
     assert_eq!(total_failures, 0, "{}", report.join("\n"));
 }
+
+#[test]
+fn build_does_not_depend_on_thread_count() {
+    // Images must be bit-identical for any --threads: the same hits, ties included, whatever
+    // the rayon pool that built the BVH.
+    let shapes = vec![
+        mesh_shape("mesh", cube_sphere(Vec3::ZERO, 1.0, 40)),
+        mesh_shape(
+            "uv",
+            uv_sphere_with_triangles(Vec3::new(0.5, 0.1, 0.0), 0.7, 20_000),
+        ),
+    ];
+    let mut rng = Random::new(0x5eed_0006);
+    let rays: Vec<Ray> = (0..50_000)
+        .map(|_| {
+            Ray::new(
+                rng.in_box(Vec3::splat(-1.5), Vec3::splat(1.5)),
+                rng.direction(),
+            )
+        })
+        .collect();
+    let hits = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let g = pool.install(|| Geometry::build(&shapes));
+        rays.iter()
+            .map(|r| {
+                g.intersect(r)
+                    .map(|s| (s.shape, s.primitive, s.t.to_bits()))
+            })
+            .collect::<Vec<_>>()
+    };
+    let one = hits(1);
+    assert!(one.iter().filter(|h| h.is_some()).count() > 10_000);
+    assert_eq!(one, hits(3));
+}

@@ -348,12 +348,15 @@ impl TriangleBvh {
         }
         let tris = hitmask & 0x00ff_ffff;
         if tris != 0 {
+            // The hit leaves' triangles are contiguous: their first and last lines.
             let first = node.primitive_base_idx + tris.trailing_zeros();
             let last = node.primitive_base_idx + 31 - tris.leading_zeros();
-            for id in first..=last {
-                if let Some(r) = self.records.get(id as usize) {
-                    prefetch(r);
-                }
+            if let (Some(a), Some(b)) = (
+                self.records.get(first as usize),
+                self.records.get(last as usize),
+            ) {
+                prefetch(a);
+                prefetch(b);
             }
         }
     }
@@ -570,9 +573,70 @@ fn slab_constants(node: &CwBvhNode, ray: &TraversalRay) -> (Vec3A, Vec3A, Vec3A)
 
 /// Which children of `node` the ray's segment (0, t_max) meets, as the traversal's hit mask:
 /// internal children set bit 24 + (slot ^ octant), leaves set their triangles' bits.
+/// Branch-free: the slab test and the mask assembly run on all 8 children at once.
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    target_feature = "fma"
+))]
 #[inline(always)]
 fn node_hitmask(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
-    let mask = child_mask(node, ray, t_max);
+    use std::arch::x86_64::*;
+    let (a, near_b, far_b) = slab_constants(node, ray);
+    // SAFETY: AVX2 and FMA are enabled for this build (cfg above); the loads read 8 bytes
+    // at field offsets inside `*node` (80 bytes, repr(C)).
+    unsafe {
+        let base = node as *const CwBvhNode as *const u8;
+        let bytes = |offset: usize| {
+            _mm256_cvtepu8_epi32(_mm_loadl_epi64(base.add(offset) as *const __m128i))
+        };
+        let load = |offset: usize| _mm256_cvtepi32_ps(bytes(offset));
+        let t_near = |k: usize, a: f32, b: f32| {
+            _mm256_fmadd_ps(load(ray.near[k]), _mm256_set1_ps(a), _mm256_set1_ps(b))
+        };
+        let t_far = |k: usize, a: f32, b: f32| {
+            _mm256_fmadd_ps(load(ray.far[k]), _mm256_set1_ps(a), _mm256_set1_ps(b))
+        };
+        let t_enter = _mm256_max_ps(
+            _mm256_max_ps(t_near(0, a.x, near_b.x), t_near(1, a.y, near_b.y)),
+            _mm256_max_ps(t_near(2, a.z, near_b.z), _mm256_setzero_ps()),
+        );
+        let t_exit = _mm256_min_ps(
+            _mm256_min_ps(t_far(0, a.x, far_b.x), t_far(1, a.y, far_b.y)),
+            _mm256_min_ps(t_far(2, a.z, far_b.z), _mm256_set1_ps(t_max)),
+        );
+        let hit = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LE_OQ>(t_enter, t_exit));
+        // Each child's meta byte m: a leaf sets its triangle count (unary, m >> 5) of bits
+        // from its first triangle's offset (m & 31); an internal child (m = 0b001_11sss for
+        // slot s) sets one bit (m >> 5 = 1) at 24 + (s ^ octant) = (m ^ octant) & 31; an
+        // empty slot (m = 0) sets none.
+        let m = bytes(std::mem::offset_of!(CwBvhNode, child_meta));
+        let set1 = _mm256_set1_epi32;
+        let inner = _mm256_cmpeq_epi32(_mm256_and_si256(m, set1(0x18)), set1(0x18));
+        let octant = _mm256_and_si256(inner, set1((ray.oct_inv4 & 0xff) as i32));
+        let index = _mm256_and_si256(_mm256_xor_si256(m, octant), set1(0x1f));
+        let bits = _mm256_and_si256(_mm256_srli_epi32::<5>(m), set1(7));
+        let v = _mm256_and_si256(_mm256_sllv_epi32(bits, index), hit);
+        let v = _mm_or_si128(_mm256_castsi256_si128(v), _mm256_extracti128_si256::<1>(v));
+        let v = _mm_or_si128(v, _mm_shuffle_epi32::<0b01_00_11_10>(v));
+        let v = _mm_or_si128(v, _mm_shuffle_epi32::<0b10_11_00_01>(v));
+        _mm_cvtsi128_si32(v) as u32
+    }
+}
+
+#[cfg(not(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    target_feature = "fma"
+)))]
+#[inline(always)]
+fn node_hitmask(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
+    node_hitmask_scalar(node, ray, t_max)
+}
+
+/// Portable version of `node_hitmask` (also the reference for the SIMD one in tests).
+pub fn node_hitmask_scalar(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
+    let mask = child_mask_scalar(node, ray, t_max);
     let (child_bits8, bit_index8) = node.get_child_and_index_bits(ray.oct_inv4);
     let mut m = mask;
     let mut hitmask = 0;
@@ -588,53 +652,6 @@ fn node_hitmask(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
 
 /// Bit c set when child slot c's box meets the segment (empty slots may be set; their
 /// child bits are zero).
-#[cfg(all(
-    target_arch = "x86_64",
-    target_feature = "avx2",
-    target_feature = "fma"
-))]
-#[inline(always)]
-fn child_mask(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
-    use std::arch::x86_64::*;
-    let (a, near_b, far_b) = slab_constants(node, ray);
-    // SAFETY: AVX2 and FMA are enabled for this build (cfg above); the loads read 8 bytes
-    // at field offsets inside `*node` (80 bytes, repr(C)).
-    unsafe {
-        let base = node as *const CwBvhNode as *const u8;
-        let load = |offset: usize| {
-            _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(
-                base.add(offset) as *const __m128i
-            )))
-        };
-        let t_near = |k: usize, a: f32, b: f32| {
-            _mm256_fmadd_ps(load(ray.near[k]), _mm256_set1_ps(a), _mm256_set1_ps(b))
-        };
-        let t_far = |k: usize, a: f32, b: f32| {
-            _mm256_fmadd_ps(load(ray.far[k]), _mm256_set1_ps(a), _mm256_set1_ps(b))
-        };
-        let t_enter = _mm256_max_ps(
-            _mm256_max_ps(t_near(0, a.x, near_b.x), t_near(1, a.y, near_b.y)),
-            _mm256_max_ps(t_near(2, a.z, near_b.z), _mm256_setzero_ps()),
-        );
-        let t_exit = _mm256_min_ps(
-            _mm256_min_ps(t_far(0, a.x, far_b.x), t_far(1, a.y, far_b.y)),
-            _mm256_min_ps(t_far(2, a.z, far_b.z), _mm256_set1_ps(t_max)),
-        );
-        _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(t_enter, t_exit)) as u32
-    }
-}
-
-#[cfg(not(all(
-    target_arch = "x86_64",
-    target_feature = "avx2",
-    target_feature = "fma"
-)))]
-#[inline(always)]
-fn child_mask(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
-    child_mask_scalar(node, ray, t_max)
-}
-
-/// Portable version of `child_mask` (also the reference for the SIMD one in tests).
 #[inline(always)]
 pub fn child_mask_scalar(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
     let (a, near_b, far_b) = slab_constants(node, ray);
@@ -668,7 +685,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn simd_child_mask_matches_scalar() {
+    fn simd_node_hitmask_matches_scalar() {
         let mut s = 12345u64;
         let mut next = || {
             s ^= s << 13;
@@ -694,8 +711,8 @@ mod tests {
             for node in &bvh.nodes {
                 let t_max = next() * 20.0;
                 assert_eq!(
-                    child_mask(node, &r, t_max),
-                    child_mask_scalar(node, &r, t_max)
+                    node_hitmask(node, &r, t_max),
+                    node_hitmask_scalar(node, &r, t_max)
                 );
             }
         }
