@@ -1938,3 +1938,104 @@ fn emitters_without_area_are_errors_naming_the_shape() {
         );
     }
 }
+
+/// Degenerate reference points and directions (on the light, at a sphere's centre, far
+/// away, not finite) never produce a NaN or infinite density or radiance.
+#[test]
+fn degenerate_queries_stay_finite() {
+    let sphere = SceneSphere {
+        center: Vec3::ZERO,
+        radius: 2.0,
+    };
+    let spot_world = Transform::new(Mat4::from_translation(Vec3::Y)).unwrap();
+    let c = Vec3::new(0.5, -0.25, 1.0);
+    let lights = vec![
+        area_light(mesh_shape(&rectangle()), Rgb::splat(1.0)),
+        area_light(mesh_shape(&pyramid()), Rgb::splat(1.0)),
+        area_light(
+            shape_desc(
+                "s",
+                ShapeGeometry::Sphere {
+                    center: c,
+                    radius: 1.0,
+                },
+                false,
+            ),
+            Rgb::splat(1.0),
+        ),
+        area_light(
+            shape_desc(
+                "s",
+                ShapeGeometry::Sphere {
+                    center: c,
+                    radius: 1.0,
+                },
+                true,
+            ),
+            Rgb::splat(1.0),
+        ),
+        area_light(
+            shape_desc(
+                "d",
+                ShapeGeometry::Disk {
+                    to_world: disk_transform(),
+                },
+                false,
+            ),
+            Rgb::splat(1.0),
+        ),
+        Light::Point(PointLight::new(Vec3::Z, Rgb::splat(1.0))),
+        Light::Spot(SpotLight::new(&spot_world, Rgb::splat(1.0), 30.0, 30.0).unwrap()),
+        Light::Directional(DirectionalLight::new(-Vec3::Z, Rgb::splat(1.0), sphere).unwrap()),
+        Light::Constant(ConstantLight::new(Rgb::splat(1.0), sphere)),
+        Light::Envmap(Box::new(test_envmap(&rotation(), 1.0))),
+    ];
+    let refs = [
+        Vec3::ZERO,
+        Vec3::Z,
+        Vec3::Y,
+        c,
+        c + Vec3::X,
+        Vec3::new(0.2, 0.3, 0.0),
+        disk_transform().point(Vec3::ZERO),
+        Vec3::splat(1e30),
+        Vec3::splat(f32::NAN),
+        Vec3::new(f32::INFINITY, 0.0, 0.0),
+    ];
+    let dirs = [Vec3::Z, -Vec3::Y, Vec3::ZERO, Vec3::splat(f32::NAN)];
+    let mut sampler = IndependentSampler::new(9);
+    for light in &lights {
+        for &r in &refs {
+            for _ in 0..200 {
+                let u = sampler.next_2d();
+                if let Some(s) = light.sample_li(r, u) {
+                    assert!(s.radiance.is_valid_radiance(), "{light:?} {r} {s:?}");
+                    assert!(s.pdf_solid_angle.is_finite() && s.pdf_solid_angle > 0.0);
+                    assert!(s.pdf_area.is_finite() && s.wi.is_finite() && !s.dist.is_nan());
+                    let back = light.pdf_li(r, &s.point());
+                    assert!(back.is_finite() && back >= 0.0);
+                }
+                for &d in &dirs {
+                    let hit = LightPoint {
+                        p: r,
+                        n: d,
+                        primitive: 0,
+                    };
+                    for q in [r, Vec3::ZERO] {
+                        let pdf = light.pdf_li(q, &hit);
+                        assert!(
+                            pdf.is_finite() && pdf >= 0.0,
+                            "{light:?} {q} {hit:?}: {pdf}"
+                        );
+                    }
+                    assert!(light.le(&hit, d).is_valid_radiance());
+                    let (pp, pd) = light.pdf_le(r, d, d);
+                    assert!(pp.is_finite() && pd.is_finite() && pp >= 0.0 && pd >= 0.0);
+                }
+                if let Some(e) = light.sample_le(u, sampler.next_2d()) {
+                    assert!(e.radiance.is_valid_radiance() && e.origin.is_finite());
+                }
+            }
+        }
+    }
+}

@@ -48,7 +48,8 @@ impl AreaLight {
         }
         let wi = d / dist;
         // One-sided: the sampled point must face the reference point.
-        if s.point.n.dot(wi) >= 0.0 {
+        let faces_r = s.point.n.dot(wi) < 0.0; // false for NaN too
+        if !faces_r {
             return None;
         }
         Some(LightSample {
@@ -66,7 +67,8 @@ impl AreaLight {
 
     /// Solid-angle density of `sample_li(r, ·)` returning `hit`: 0 for points facing away.
     pub fn pdf_li(&self, r: Vec3, hit: &LightPoint) -> f32 {
-        if hit.n.dot(r - hit.p) <= 0.0 {
+        let faces_r = hit.n.dot(r - hit.p) > 0.0; // false for NaN too
+        if !faces_r {
             return 0.0;
         }
         self.shape.pdf_from(r, hit.p, hit.n)

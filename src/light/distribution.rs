@@ -96,7 +96,8 @@ impl Distribution1D {
         } else {
             0.0
         };
-        (i, width as f32, remapped.clamp(0.0, ONE_MINUS_EPSILON))
+        // The probability as `pmf` computes it, so MIS weights see identical values.
+        (i, self.pmf(i), remapped.clamp(0.0, ONE_MINUS_EPSILON))
     }
 
     /// Probability of item `i`.

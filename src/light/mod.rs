@@ -346,12 +346,19 @@ impl Light {
     }
 
     /// Solid-angle density of `sample_li(ref_point, ·)` producing `hit` (0 for delta lights).
+    /// A density too large for f32 (a light seen from astronomically far away) is 0: no
+    /// sample could have been drawn there either (`sample_li` drops such samples).
     pub fn pdf_li(&self, ref_point: Vec3, hit: &LightPoint) -> f32 {
-        match self {
+        let pdf = match self {
             Light::Area(l) => l.pdf_li(ref_point, hit),
             Light::Point(_) | Light::Spot(_) | Light::Directional(_) => 0.0,
             Light::Constant(l) => l.pdf_li(),
             Light::Envmap(l) => l.pdf_direction(hit.p),
+        };
+        if pdf.is_finite() && pdf > 0.0 {
+            pdf
+        } else {
+            0.0
         }
     }
 
@@ -389,14 +396,16 @@ impl Light {
     /// (pdf_pos, pdf_dir) of `sample_le` producing the ray from `p` (normal `n`, area
     /// lights) in direction `dir`; delta components count 1, as `sample_le` reports them.
     pub fn pdf_le(&self, _p: Vec3, n: Vec3, dir: Vec3) -> (f32, f32) {
-        match self {
+        let (pos, d) = match self {
             Light::Area(l) => l.pdf_le(n, dir),
             Light::Point(l) => l.pdf_le(),
             Light::Spot(l) => l.pdf_le(dir),
             Light::Directional(l) => l.pdf_le(),
             Light::Constant(l) => l.pdf_le(dir),
             Light::Envmap(l) => l.pdf_le(dir),
-        }
+        };
+        let clean = |x: f32| if x.is_finite() && x > 0.0 { x } else { 0.0 };
+        (clean(pos), clean(d))
     }
 }
 
