@@ -257,7 +257,9 @@ impl Light {
                 position,
             } => {
                 if !position.is_finite() {
-                    return Err(fail(format!("point light at {position:?}")));
+                    return Err(fail(format!(
+                        "point light position {position:?} is not finite"
+                    )));
                 }
                 Light::Point(PointLight::new(*position, *intensity))
             }
@@ -275,7 +277,9 @@ impl Light {
                 direction,
             } => Light::Directional(
                 DirectionalLight::new(*direction, *irradiance, sphere).ok_or_else(|| {
-                    fail(format!("directional light with direction {direction:?}"))
+                    fail(format!(
+                        "directional light direction {direction:?} cannot be normalised"
+                    ))
                 })?,
             ),
             EmitterDesc::Constant { radiance } => {
