@@ -1740,7 +1740,8 @@ fn delta_lights_give_intensity_over_distance_squared() {
     assert_eq!(point.pdf_li(x, &s.point()), 0.0);
 
     // Spot along −z from the origin, cutoff 30°, beam 20°: f = 1 within 20°, (30 − θ)/10
-    // between, 0 beyond.
+    // between, 0 beyond. (Mitsuba 3.9.1's `spot`, placed the same way, returns the same
+    // I·f/d² at these points: (1, 2, 3) × 1, 1, 0.5, 0.2, 0.)
     let to_world =
         Transform::new(Mat4::from_quat(Quat::from_rotation_x(std::f32::consts::PI))).unwrap();
     let spot = Light::Spot(SpotLight::new(&to_world, i, 30.0, 20.0).unwrap());
