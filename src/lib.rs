@@ -10,6 +10,7 @@ pub mod film;
 pub mod geometry;
 pub mod image;
 pub mod io;
+pub mod light;
 pub mod material;
 pub mod math;
 pub mod render;

@@ -1574,8 +1574,6 @@ fn structure_errors() {
 fn unsupported_features_say_so() {
     for (body, element) in [
         ("<sensor type=\"thinlens\"/>", "<sensor type=\"thinlens\">"),
-        ("<emitter type=\"spot\"/>", "<emitter type=\"spot\">"),
-        ("<emitter type=\"envmap\"/>", "<emitter type=\"envmap\">"),
         ("<emitter type=\"sunsky\"/>", "<emitter type=\"sunsky\">"),
         (
             "<medium type=\"homogeneous\" id=\"fog\"/>",

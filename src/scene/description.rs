@@ -239,6 +239,23 @@ pub enum EmitterDesc {
     Directional { irradiance: Rgb, direction: Vec3 },
     /// Uniform radiance from every direction at infinity.
     Constant { radiance: Rgb },
+    /// Mitsuba 3 `spot`: radiant intensity `intensity` (W/sr) at the centre of a cone along
+    /// the local +z axis placed by `to_world` (a rigid motion, possibly uniformly scaled),
+    /// full up to `beam_width` and falling off linearly in angle to zero at `cutoff_angle`.
+    /// Both angles are in degrees, as written in the scene (0 ≤ beam_width ≤ cutoff_angle).
+    Spot {
+        intensity: Rgb,
+        to_world: Transform,
+        cutoff_angle: f32,
+        beam_width: f32,
+    },
+    /// Mitsuba 3 `envmap`: a latitude-longitude OpenEXR image of radiance (times `scale`)
+    /// at infinity, oriented by `to_world` (a rotation). `filename` is already resolved.
+    Envmap {
+        filename: std::path::PathBuf,
+        scale: f32,
+        to_world: Transform,
+    },
 }
 
 /// A triangle mesh in world space. Invariant: indices are in range, triangles have area > 0.

@@ -1,5 +1,6 @@
-//! `<emitter>`: area lights attached to shapes, and the point, directional and constant
-//! emitters that stand alone. Every emitted quantity defaults to 1, as in Mitsuba 3.
+//! `<emitter>`: area lights attached to shapes, and the point, spot, directional, constant
+//! and envmap emitters that stand alone. Every emitted quantity defaults to 1, as in
+//! Mitsuba 3.
 
 use glam::Vec3;
 
@@ -11,7 +12,7 @@ use crate::math::Rgb;
 use crate::scene::EmitterDesc;
 
 /// Mitsuba emitters mltbench does not implement yet.
-const UNSUPPORTED: &[&str] = &["spot", "envmap", "sunsky", "sky", "sun", "projector"];
+const UNSUPPORTED: &[&str] = &["sunsky", "sky", "sun", "projector"];
 
 impl Builder<'_> {
     /// The radiance of an `<emitter type="area">` nested in (or referenced by) a shape.
@@ -25,7 +26,7 @@ impl Builder<'_> {
                     format!("emitter type \"{kind}\" is not supported yet"),
                 ));
             }
-            "point" | "directional" | "constant" => {
+            "point" | "spot" | "directional" | "constant" | "envmap" => {
                 return Err(tree.error(elem, "only area emitters can be attached to a shape"));
             }
             kind => return Err(tree.error(elem, format!("unknown emitter type \"{kind}\""))),
@@ -83,26 +84,138 @@ impl Builder<'_> {
                     direction: unit,
                 }
             }
+            "spot" => self.spot(&props)?,
             "constant" => {
-                if let Some(previous) = self.environment {
-                    return Err(tree.error(
-                        elem,
-                        format!(
-                            "only one environment emitter per scene (the first is at line {})",
-                            tree.elem(previous).line
-                        ),
-                    ));
-                }
-                self.environment = Some(elem);
+                self.claim_environment(elem)?;
                 EmitterDesc::Constant {
                     radiance: emission(&props, "radiance")?,
                 }
+            }
+            "envmap" => {
+                self.claim_environment(elem)?;
+                self.envmap(&props)?
             }
             other => return Err(tree.error(elem, format!("unknown emitter type \"{other}\""))),
         };
         props.finish()?;
         self.desc.emitters.push(desc);
         Ok(true)
+    }
+}
+
+impl Builder<'_> {
+    /// Mitsuba 3 allows one environment emitter (`constant` or `envmap`) per scene.
+    fn claim_environment(&mut self, elem: ElemId) -> Result<()> {
+        if let Some(previous) = self.environment {
+            return Err(self.tree.error(
+                elem,
+                format!(
+                    "only one environment emitter per scene (the first is at line {})",
+                    self.tree.elem(previous).line
+                ),
+            ));
+        }
+        self.environment = Some(elem);
+        Ok(())
+    }
+
+    /// `spot`: `intensity`, `cutoff_angle` (degrees, default 20), `beam_width` (degrees,
+    /// default 3/4 of the cutoff), `to_world`.
+    fn spot(&self, props: &Props) -> Result<EmitterDesc> {
+        let tree = self.tree;
+        let intensity = emission(props, "intensity")?;
+        let cutoff_angle = props.float("cutoff_angle")?.unwrap_or(20.0);
+        if !(cutoff_angle > 0.0 && cutoff_angle <= 180.0) {
+            return Err(tree.error(
+                props.elem_of("cutoff_angle"),
+                format!("cutoff_angle must be in (0, 180] degrees, got {cutoff_angle}"),
+            ));
+        }
+        let beam_width = props.float("beam_width")?.unwrap_or(cutoff_angle * 0.75);
+        if !(beam_width >= 0.0 && beam_width <= cutoff_angle) {
+            return Err(tree.error(
+                props.elem_of("beam_width"),
+                format!(
+                    "beam_width must be between 0 and cutoff_angle ({cutoff_angle}) degrees, \
+                     got {beam_width}"
+                ),
+            ));
+        }
+        let to_world = props.transform("to_world")?.unwrap_or_default();
+        if uniform_scale(&to_world).is_none() {
+            return Err(tree.error(
+                props.elem_of("to_world"),
+                "the to_world of a spot light may rotate, translate and scale uniformly, \
+                 but not scale unevenly or shear (the cone would no longer be round)",
+            ));
+        }
+        Ok(EmitterDesc::Spot {
+            intensity,
+            to_world,
+            cutoff_angle,
+            beam_width,
+        })
+    }
+
+    /// `envmap`: `filename` (resolved like mesh files and recorded in `files_read`),
+    /// `scale` (default 1), `to_world` (a rotation).
+    fn envmap(&mut self, props: &Props) -> Result<EmitterDesc> {
+        let tree = self.tree;
+        let Some(filename) = props.string("filename")? else {
+            return Err(tree.error(props.owner(), "an envmap emitter needs a \"filename\""));
+        };
+        let named_at = props.elem_of("filename");
+        let (found, searched) = tree.resolve_file(filename, tree.elem(named_at).file);
+        let Some(path) = found else {
+            let list: Vec<String> = searched.iter().map(|p| p.display().to_string()).collect();
+            return Err(tree.error(
+                named_at,
+                format!(
+                    "environment map \"{filename}\" not found (searched: {})",
+                    list.join(", ")
+                ),
+            ));
+        };
+        let scale = props.float("scale")?.unwrap_or(1.0);
+        if !(scale.is_finite() && scale >= 0.0) {
+            return Err(tree.error(
+                props.elem_of("scale"),
+                format!("scale must be finite and not negative, got {scale}"),
+            ));
+        }
+        let to_world = props.transform("to_world")?.unwrap_or_default();
+        if uniform_scale(&to_world).is_none_or(|s| (s - 1.0).abs() > 1e-4) {
+            return Err(tree.error(
+                props.elem_of("to_world"),
+                "the to_world of an envmap must be a rotation (Mitsuba 3 does not \
+                 renormalise directions after a scaling)",
+            ));
+        }
+        if !self.desc.files_read.contains(&path) {
+            self.desc.files_read.push(path.clone());
+        }
+        Ok(EmitterDesc::Envmap {
+            filename: path,
+            scale,
+            to_world,
+        })
+    }
+}
+
+/// The factor s when the linear part of `t` is s times an orthogonal matrix (a rotation or
+/// reflection scaled uniformly), to a relative tolerance of 10⁻⁴; None otherwise.
+fn uniform_scale(t: &crate::math::Transform) -> Option<f32> {
+    let m = glam::Mat3::from_mat4(t.matrix).as_dmat3();
+    let g = m.transpose() * m; // = s² I for a similarity
+    let s2 = (g.x_axis.x + g.y_axis.y + g.z_axis.z) / 3.0;
+    if !(s2.is_finite() && s2 > 0.0) {
+        return None;
+    }
+    let off = (g - glam::DMat3::from_diagonal(glam::DVec3::splat(s2))).to_cols_array();
+    if off.iter().all(|v| v.abs() <= 1e-4 * s2) {
+        Some(s2.sqrt() as f32)
+    } else {
+        None
     }
 }
 

@@ -1,0 +1,278 @@
+//! Piecewise-constant distributions sampled by inverting their cumulative distribution:
+//! a 1D one over n equal intervals of [0, 1) (or, read discretely, over n items), and a 2D
+//! one over an image's cells as a marginal distribution over rows times a conditional
+//! distribution within the chosen row ("inverse transform sampling for images"; Pharr,
+//! Jakob & Humphreys, *Physically Based Rendering*, 3rd ed., §13.6.5–13.6.7).
+//!
+//! The cumulative sums are kept in f64: with a million cells an f32 sum would round small
+//! cells to zero width, so they could never be drawn although their pdf is positive.
+
+use glam::Vec2;
+
+/// The largest f32 below one: sampled positions stay in [0, 1).
+const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// A piecewise-constant density on [0, 1) with `n` equal intervals, proportional to the
+/// weights it was built from; equally the discrete distribution with probabilities
+/// weight_i / Σ weight.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Distribution1D {
+    /// The weights, as given.
+    func: Vec<f32>,
+    /// cdf[i] = Σ_{k<i} func[k] / Σ func; cdf[0] = 0, cdf[n] = 1.
+    cdf: Vec<f64>,
+    /// Σ func (the integral of the step function over [0, 1) is sum / n).
+    sum: f64,
+}
+
+impl Distribution1D {
+    /// None when there are no weights, a weight is negative or not finite, or all are zero.
+    pub fn new(weights: &[f32]) -> Option<Distribution1D> {
+        if weights.is_empty() || weights.iter().any(|w| !(w.is_finite() && *w >= 0.0)) {
+            return None;
+        }
+        let mut cdf = Vec::with_capacity(weights.len() + 1);
+        let mut acc = 0.0f64;
+        cdf.push(0.0);
+        for &w in weights {
+            acc += w as f64;
+            cdf.push(acc);
+        }
+        if !(acc > 0.0 && acc.is_finite()) {
+            return None;
+        }
+        for c in &mut cdf {
+            *c /= acc;
+        }
+        cdf[weights.len()] = 1.0;
+        Some(Distribution1D {
+            func: weights.to_vec(),
+            cdf,
+            sum: acc,
+        })
+    }
+
+    /// Equal weights over `n` ≥ 1 items.
+    pub fn uniform(n: usize) -> Distribution1D {
+        Distribution1D::new(&vec![1.0; n.max(1)]).expect("positive weights")
+    }
+
+    /// Number of intervals (items).
+    pub fn len(&self) -> usize {
+        self.func.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.func.is_empty()
+    }
+
+    /// The weight of item `i` as given.
+    pub fn weight(&self, i: usize) -> f32 {
+        self.func[i]
+    }
+
+    /// Σ weights.
+    pub fn sum(&self) -> f64 {
+        self.sum
+    }
+
+    /// The item whose cdf interval [cdf[i], cdf[i+1]) holds `u`. Never an item of weight 0
+    /// (its interval is empty).
+    fn find(&self, u: f64) -> usize {
+        // Largest i with cdf[i] <= u, among 0..n.
+        let n = self.func.len();
+        let i = self.cdf.partition_point(|&c| c <= u);
+        i.saturating_sub(1).min(n - 1)
+    }
+
+    /// Draws an item: (index, its probability, `u` rescaled to [0, 1) within the item's cdf
+    /// interval, fresh for reuse).
+    pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
+        let u = (u.clamp(0.0, ONE_MINUS_EPSILON)) as f64;
+        let i = self.find(u);
+        let width = self.cdf[i + 1] - self.cdf[i];
+        let remapped = if width > 0.0 {
+            ((u - self.cdf[i]) / width) as f32
+        } else {
+            0.0
+        };
+        // The probability as `pmf` computes it, so MIS weights see identical values.
+        (i, self.pmf(i), remapped.clamp(0.0, ONE_MINUS_EPSILON))
+    }
+
+    /// Probability of item `i`.
+    pub fn pmf(&self, i: usize) -> f32 {
+        if i < self.func.len() {
+            (self.func[i] as f64 / self.sum) as f32
+        } else {
+            0.0
+        }
+    }
+
+    /// Draws x in [0, 1) with the step density: (x, density at x, interval index).
+    pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
+        let (i, _, du) = self.sample_discrete(u);
+        let n = self.func.len();
+        let x = ((i as f32 + du) / n as f32).min(ONE_MINUS_EPSILON);
+        (x, self.density(i), i)
+    }
+
+    /// The density of interval `i`: n · weight_i / Σ weight.
+    fn density(&self, i: usize) -> f32 {
+        (self.func[i] as f64 * self.func.len() as f64 / self.sum) as f32
+    }
+
+    /// The density at x (0 outside [0, 1)).
+    pub fn pdf(&self, x: f32) -> f32 {
+        if !(0.0..1.0).contains(&x) {
+            return 0.0;
+        }
+        let n = self.func.len();
+        let i = ((x * n as f32) as usize).min(n - 1);
+        self.density(i)
+    }
+}
+
+/// A piecewise-constant density on [0, 1)² over an `nu` × `nv` grid of cells (row-major,
+/// row index along v), proportional to the cell weights.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Distribution2D {
+    /// One distribution over u per row (uniform for rows of zero weight, never drawn).
+    conditional: Vec<Distribution1D>,
+    /// Over rows, by row sums.
+    marginal: Distribution1D,
+    nu: usize,
+    nv: usize,
+}
+
+impl Distribution2D {
+    /// `weights[v * nu + u]`. None when the sizes disagree, a weight is negative or not
+    /// finite, or all are zero.
+    pub fn new(weights: &[f32], nu: usize, nv: usize) -> Option<Distribution2D> {
+        if nu == 0 || nv == 0 || weights.len() != nu.checked_mul(nv)? {
+            return None;
+        }
+        if weights.iter().any(|w| !(w.is_finite() && *w >= 0.0)) {
+            return None;
+        }
+        let mut conditional = Vec::with_capacity(nv);
+        let mut row_sums = Vec::with_capacity(nv);
+        for row in weights.chunks_exact(nu) {
+            match Distribution1D::new(row) {
+                Some(d) => {
+                    row_sums.push(d.sum() as f32);
+                    conditional.push(d);
+                }
+                None => {
+                    row_sums.push(0.0);
+                    conditional.push(Distribution1D::uniform(nu));
+                }
+            }
+        }
+        let marginal = Distribution1D::new(&row_sums)?;
+        Some(Distribution2D {
+            conditional,
+            marginal,
+            nu,
+            nv,
+        })
+    }
+
+    pub fn size(&self) -> (usize, usize) {
+        (self.nu, self.nv)
+    }
+
+    /// Draws (u, v) in [0, 1)²: the row by the marginal with `u.y`, then u within the row
+    /// with `u.x`. Returns the point, its density on [0, 1)² and the cell (iu, iv).
+    pub fn sample(&self, u: Vec2) -> (Vec2, f32, [usize; 2]) {
+        let (v, pdf_v, iv) = self.marginal.sample_continuous(u.y);
+        let (x, pdf_u, iu) = self.conditional[iv].sample_continuous(u.x);
+        (Vec2::new(x, v), pdf_v * pdf_u, [iu, iv])
+    }
+
+    /// The density at (u, v) (0 outside [0, 1)²).
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        if !((0.0..1.0).contains(&p.x) && (0.0..1.0).contains(&p.y)) {
+            return 0.0;
+        }
+        let iu = ((p.x * self.nu as f32) as usize).min(self.nu - 1);
+        let iv = ((p.y * self.nv as f32) as usize).min(self.nv - 1);
+        self.cell_pdf(iu, iv)
+    }
+
+    /// The density in cell (iu, iv): nu · nv · weight / Σ weights.
+    pub fn cell_pdf(&self, iu: usize, iv: usize) -> f32 {
+        let w = self.conditional[iv].weight(iu) as f64;
+        if self.marginal.weight(iv) == 0.0 {
+            return 0.0;
+        }
+        (w * (self.nu * self.nv) as f64 / self.marginal.sum()) as f32
+    }
+
+    /// The probability of drawing a point in cell (iu, iv).
+    pub fn cell_probability(&self, iu: usize, iv: usize) -> f32 {
+        self.cell_pdf(iu, iv) / (self.nu * self.nv) as f32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn discrete_probabilities_and_remapping() {
+        let d = Distribution1D::new(&[1.0, 0.0, 3.0]).unwrap();
+        assert_eq!(d.pmf(0), 0.25);
+        assert_eq!(d.pmf(1), 0.0);
+        assert_eq!(d.pmf(2), 0.75);
+        // u in [0, 0.25) → item 0, [0.25, 1) → item 2; never the empty item 1.
+        let (i, p, r) = d.sample_discrete(0.125);
+        assert_eq!((i, p), (0, 0.25));
+        assert!((r - 0.5).abs() < 1e-6);
+        let (i, _, r) = d.sample_discrete(0.25);
+        assert_eq!(i, 2);
+        assert!(r.abs() < 1e-6);
+        assert_eq!(d.sample_discrete(0.999_999_9).0, 2);
+        assert_eq!(d.sample_discrete(1.0).0, 2);
+    }
+
+    #[test]
+    fn bad_weights_give_none() {
+        assert!(Distribution1D::new(&[]).is_none());
+        assert!(Distribution1D::new(&[0.0, 0.0]).is_none());
+        assert!(Distribution1D::new(&[1.0, f32::NAN]).is_none());
+        assert!(Distribution1D::new(&[1.0, -1.0]).is_none());
+        assert!(Distribution1D::new(&[1.0, f32::INFINITY]).is_none());
+        assert!(Distribution2D::new(&[1.0; 5], 2, 3).is_none());
+        assert!(Distribution2D::new(&[0.0; 6], 2, 3).is_none());
+    }
+
+    #[test]
+    fn continuous_density_matches_weights() {
+        let d = Distribution1D::new(&[1.0, 2.0, 1.0]).unwrap();
+        // density n · w / Σ w = 3 · w / 4
+        assert!((d.pdf(0.1) - 0.75).abs() < 1e-6);
+        assert!((d.pdf(0.5) - 1.5).abs() < 1e-6);
+        let (x, pdf, i) = d.sample_continuous(0.5);
+        assert_eq!(i, 1);
+        assert!((x - 0.5).abs() < 1e-6);
+        assert!((pdf - 1.5).abs() < 1e-6);
+    }
+
+    #[test]
+    fn two_d_rows_of_zero_weight_are_never_drawn() {
+        let w = [0.0, 0.0, 1.0, 3.0];
+        let d = Distribution2D::new(&w, 2, 2).unwrap();
+        for k in 0..100 {
+            let u = Vec2::new((k as f32 + 0.5) / 100.0, (k as f32 * 0.37 + 0.1).fract());
+            let (p, pdf, [iu, iv]) = d.sample(u);
+            assert_eq!(iv, 1);
+            assert!((d.pdf(p) - pdf).abs() < 1e-5 * pdf);
+            assert!((d.cell_pdf(iu, iv) - pdf).abs() < 1e-5 * pdf);
+        }
+        assert_eq!(d.cell_pdf(0, 0), 0.0);
+        // density nu·nv·w/Σw: 4·1/4 and 4·3/4
+        assert!((d.cell_pdf(0, 1) - 1.0).abs() < 1e-6);
+        assert!((d.cell_pdf(1, 1) - 3.0).abs() < 1e-6);
+    }
+}

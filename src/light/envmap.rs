@@ -1,0 +1,268 @@
+//! Environment maps (Mitsuba 3's `envmap`): radiance at infinity from a latitude-longitude
+//! OpenEXR image, times `scale`, oriented by `to_world` (a rotation).
+//!
+//! Mapping (Mitsuba 3, MITSUBA-NOTES.md): in the map's local frame +y is up; a direction d
+//! has u = atan2(d.x, −d.z)/2π and v = acos(d.y)/π. The lookup is bilinear with texel
+//! values placed at grid points: horizontally texel i sits at u = (i + ½)/W and the map
+//! wraps around (column W is column 0); vertically row j sits at v = j/(H − 1), so row 0 is
+//! exactly the zenith and row H − 1 the nadir. The image needs W ≥ 2 and H ≥ 3 (Mitsuba's
+//! minimum).
+//!
+//! Sampling: the bilinear patches between neighbouring texels are the W × (H − 1) cells
+//! of a `Distribution2D`, each weighted by the mean luminance of its four corners times its
+//! solid angle (2π/W)(cos θ_j − cos θ_{j+1}) — "luminance × sin θ", integrated exactly over
+//! the cell's band of latitudes. Within a cell the direction is uniform in solid angle
+//! (φ uniform, cos θ uniform), so the density is the cell's probability over its solid
+//! angle: bounded, with no 1/sin θ growth at the poles. A cell is drawable exactly when the
+//! bilinear radiance in it can be non-zero, so the estimator stays unbiased.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat3, Vec2, Vec3};
+
+use crate::error::{Error, Location, Result};
+use crate::io::exr::read_exr;
+use crate::light::distribution::Distribution2D;
+use crate::light::{EmissionSample, LightSample, SceneSphere};
+use crate::math::{PI, Rgb, Transform};
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct EnvmapLight {
+    pub filename: PathBuf,
+    width: usize,
+    height: usize,
+    /// Radiance (texel × scale), row-major, row 0 at the zenith.
+    texels: Vec<Rgb>,
+    to_world: Mat3,
+    to_local: Mat3,
+    /// cos θ of each texel row: cos(π j / (H − 1)).
+    cos_rows: Vec<f32>,
+    /// None when the map is black everywhere.
+    cells: Option<Distribution2D>,
+    sphere: SceneSphere,
+    power: f32,
+}
+
+impl EnvmapLight {
+    /// Reads the image. Errors name the file: unreadable, smaller than 2 × 3, or a texel that
+    /// is negative or not finite.
+    pub fn load(
+        filename: &Path,
+        scale: f32,
+        to_world: &Transform,
+        sphere: SceneSphere,
+    ) -> Result<EnvmapLight> {
+        let image = read_exr(filename)?;
+        EnvmapLight::from_texels(
+            filename,
+            image.width as usize,
+            image.height as usize,
+            &image.pixels,
+            scale,
+            to_world,
+            sphere,
+        )
+    }
+
+    /// The same from texels in memory (row-major, row 0 at the zenith); `filename` names
+    /// them in messages.
+    pub fn from_texels(
+        filename: &Path,
+        width: usize,
+        height: usize,
+        texels: &[Rgb],
+        scale: f32,
+        to_world: &Transform,
+        sphere: SceneSphere,
+    ) -> Result<EnvmapLight> {
+        let fail = |message: String| Error::input(Location::file(filename), message);
+        if width < 2 || height < 3 || texels.len() != width * height {
+            return Err(fail(format!(
+                "an environment map needs at least 2×3 texels, got {width}×{height}"
+            )));
+        }
+        if !(scale.is_finite() && scale >= 0.0) {
+            return Err(fail(format!(
+                "the environment map's scale must be finite and not negative, got {scale}"
+            )));
+        }
+        if let Some(k) = texels.iter().position(|t| !t.is_valid_radiance()) {
+            return Err(fail(format!(
+                "texel ({}, {}) of the environment map is {:?}: radiance must be finite and \
+                 not negative",
+                k % width,
+                k / width,
+                texels[k].0
+            )));
+        }
+        let linear = Mat3::from_mat4(to_world.matrix);
+        let to_local = linear.inverse();
+        if !(linear.is_finite() && to_local.is_finite()) {
+            return Err(fail(
+                "the environment map's to_world is singular".to_string(),
+            ));
+        }
+        let texels: Vec<Rgb> = texels.iter().map(|&t| t * scale).collect();
+        let rows = height - 1;
+        let cos_rows: Vec<f32> = (0..height)
+            .map(|j| {
+                if j == rows {
+                    -1.0
+                } else {
+                    (std::f64::consts::PI * j as f64 / rows as f64).cos() as f32
+                }
+            })
+            .collect();
+        let mut weights = Vec::with_capacity(width * rows);
+        let mut flux = 0.0f64; // ∫ L̄ dω by the cell rule
+        for j in 0..rows {
+            let band = (cos_rows[j] - cos_rows[j + 1]) as f64;
+            for i in 0..width {
+                let i1 = (i + 1) % width;
+                let corners = [
+                    texels[j * width + i],
+                    texels[j * width + i1],
+                    texels[(j + 1) * width + i],
+                    texels[(j + 1) * width + i1],
+                ];
+                let lum: f32 = corners.iter().map(|c| c.luminance()).sum::<f32>() * 0.25;
+                let mean: f64 = corners.iter().map(|c| c.mean() as f64).sum::<f64>() * 0.25;
+                weights.push((lum as f64 * band) as f32);
+                flux += mean * band * 2.0 * std::f64::consts::PI / width as f64;
+            }
+        }
+        let cells = Distribution2D::new(&weights, width, rows);
+        let r = sphere.radius as f64;
+        let power = (std::f64::consts::PI * r * r * flux) as f32;
+        Ok(EnvmapLight {
+            filename: filename.to_path_buf(),
+            width,
+            height,
+            texels,
+            to_world: linear,
+            to_local,
+            cos_rows,
+            cells,
+            sphere,
+            power,
+        })
+    }
+
+    pub fn size(&self) -> (usize, usize) {
+        (self.width, self.height)
+    }
+
+    /// Φ = π R² ∫ L̄ dω: the flux entering the scene's bounding sphere. The integral is
+    /// taken cell by cell with the mean of the four corners (exact for the bilinear lookup
+    /// along φ, a close approximation along θ).
+    pub fn power(&self) -> f32 {
+        self.power
+    }
+
+    /// Radiance arriving from world direction `wi` (pointing towards the environment).
+    pub fn le(&self, wi: Vec3) -> Rgb {
+        self.lookup(self.to_local * wi)
+    }
+
+    /// Bilinear lookup of local direction `d` (not necessarily unit).
+    pub fn lookup(&self, d: Vec3) -> Rgb {
+        let d = d.normalize_or_zero();
+        if d == Vec3::ZERO {
+            return Rgb::BLACK;
+        }
+        let (w, h) = (self.width, self.height);
+        let u = d.x.atan2(-d.z) * (0.5 / PI);
+        let v = d.y.clamp(-1.0, 1.0).acos() / PI;
+        let x = (u * w as f32 - 0.5).rem_euclid(w as f32);
+        let y = v * (h - 1) as f32;
+        let i0 = (x as usize).min(w - 1);
+        let j0 = (y as usize).min(h - 2);
+        let fx = (x - i0 as f32).clamp(0.0, 1.0);
+        let fy = (y - j0 as f32).clamp(0.0, 1.0);
+        let i1 = (i0 + 1) % w;
+        let t = |i: usize, j: usize| self.texels[j * w + i];
+        let top = t(i0, j0) * (1.0 - fx) + t(i1, j0) * fx;
+        let bottom = t(i0, j0 + 1) * (1.0 - fx) + t(i1, j0 + 1) * fx;
+        top * (1.0 - fy) + bottom * fy
+    }
+
+    /// Solid angle of the cells in row j.
+    fn cell_solid_angle(&self, j: usize) -> f32 {
+        2.0 * PI / self.width as f32 * (self.cos_rows[j] - self.cos_rows[j + 1])
+    }
+
+    /// A world direction towards the environment with its solid-angle density.
+    pub fn sample_direction(&self, u: Vec2) -> Option<(Vec3, f32)> {
+        let cells = self.cells.as_ref()?;
+        let (uv, _, [iu, iv]) = cells.sample(u);
+        let fx = (uv.x * self.width as f32 - iu as f32).clamp(0.0, 1.0);
+        let fy = (uv.y * (self.height - 1) as f32 - iv as f32).clamp(0.0, 1.0);
+        let phi = 2.0 * PI * (iu as f32 + fx + 0.5) / self.width as f32;
+        let cos = self.cos_rows[iv] + (self.cos_rows[iv + 1] - self.cos_rows[iv]) * fy;
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let local = Vec3::new(phi.sin() * sin, cos, -phi.cos() * sin);
+        let wi = (self.to_world * local).normalize();
+        let pdf = cells.cell_probability(iu, iv) / self.cell_solid_angle(iv);
+        (pdf > 0.0 && pdf.is_finite() && wi.is_finite()).then_some((wi, pdf))
+    }
+
+    /// Solid-angle density of `sample_direction` producing world direction `wi`.
+    pub fn pdf_direction(&self, wi: Vec3) -> f32 {
+        let Some(cells) = self.cells.as_ref() else {
+            return 0.0;
+        };
+        let d = (self.to_local * wi).normalize_or_zero();
+        if d == Vec3::ZERO {
+            return 0.0;
+        }
+        let w = self.width;
+        let u = d.x.atan2(-d.z) * (0.5 / PI);
+        let iu = ((u * w as f32 - 0.5).rem_euclid(w as f32) as usize).min(w - 1);
+        // Row band j holds cos θ in [cos_rows[j+1], cos_rows[j]] (cos θ decreasing in j).
+        let cos = d.y.clamp(-1.0, 1.0);
+        let rows = self.height - 1;
+        let iv = self.cos_rows[1..rows]
+            .partition_point(|&c| c > cos)
+            .min(rows - 1);
+        cells.cell_probability(iu, iv) / self.cell_solid_angle(iv)
+    }
+
+    pub fn sample_li(&self, u: Vec2) -> Option<LightSample> {
+        let (wi, pdf) = self.sample_direction(u)?;
+        Some(LightSample {
+            p: wi,
+            n: -wi,
+            primitive: 0,
+            wi,
+            dist: f32::INFINITY,
+            radiance: self.le(wi),
+            pdf_solid_angle: pdf,
+            pdf_area: pdf,
+            delta: false,
+        })
+    }
+
+    /// A direction by the map's distribution, a uniform point of the disk of radius R
+    /// perpendicular to it, R before the scene's centre.
+    pub fn sample_le(&self, u1: Vec2, u2: Vec2) -> Option<EmissionSample> {
+        let (wi, pdf_dir) = self.sample_direction(u2)?;
+        let direction = -wi;
+        let (origin, pdf_pos) = self.sphere.sample_disk(direction, u1);
+        Some(EmissionSample {
+            origin,
+            direction,
+            n: direction,
+            primitive: 0,
+            radiance: self.le(wi),
+            pdf_pos,
+            pdf_dir,
+            delta_pos: false,
+            delta_dir: false,
+        })
+    }
+
+    /// (1/(πR²), density of the direction −`dir` towards the environment).
+    pub fn pdf_le(&self, dir: Vec3) -> (f32, f32) {
+        (self.sphere.disk_pdf(), self.pdf_direction(-dir))
+    }
+}

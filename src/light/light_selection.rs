@@ -1,0 +1,39 @@
+//! Choosing one light for next-event estimation or for starting a light path: with
+//! probability proportional to its power (`Light::power`), so bright lights get the samples.
+//!
+//! A light of zero power is never chosen. Every light that emits anything has positive
+//! power (given a scene with positive extent), so choosing by power keeps the estimators
+//! unbiased; estimators that combine strategies with MIS must use `pmf` for the chance of
+//! having chosen the light an emitter hit belongs to.
+
+use crate::light::distribution::Distribution1D;
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct LightSelection {
+    /// None when no light has positive power.
+    by_power: Option<Distribution1D>,
+}
+
+impl LightSelection {
+    /// From the lights' powers (negative or non-finite powers count as 0).
+    pub fn new(powers: &[f32]) -> LightSelection {
+        let weights: Vec<f32> = powers
+            .iter()
+            .map(|&p| if p.is_finite() && p > 0.0 { p } else { 0.0 })
+            .collect();
+        LightSelection {
+            by_power: Distribution1D::new(&weights),
+        }
+    }
+
+    /// (light index, its probability, `u` rescaled to [0, 1) for reuse); None when there
+    /// is no light to choose.
+    pub fn sample(&self, u: f32) -> Option<(usize, f32, f32)> {
+        self.by_power.as_ref().map(|d| d.sample_discrete(u))
+    }
+
+    /// Probability of choosing light `i`.
+    pub fn pmf(&self, i: usize) -> f32 {
+        self.by_power.as_ref().map_or(0.0, |d| d.pmf(i))
+    }
+}

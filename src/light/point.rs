@@ -1,0 +1,68 @@
+//! Isotropic point lights (Mitsuba 3's `point`): radiant intensity I in every direction.
+
+use glam::{Vec2, Vec3};
+
+use crate::light::{EmissionSample, LightSample};
+use crate::math::{PI, Rgb, warp};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointLight {
+    pub position: Vec3,
+    /// Radiant intensity I (W/sr).
+    pub intensity: Rgb,
+}
+
+impl PointLight {
+    pub fn new(position: Vec3, intensity: Rgb) -> Self {
+        PointLight {
+            position,
+            intensity,
+        }
+    }
+
+    /// Φ = 4π Ī (exact).
+    pub fn power(&self) -> f32 {
+        4.0 * PI * self.intensity.mean()
+    }
+
+    /// The only direction: towards the light, carrying I/d² (a delta sample, pdf 1).
+    pub fn sample_li(&self, r: Vec3) -> Option<LightSample> {
+        let d = self.position - r;
+        let dist2 = d.length_squared();
+        if !(dist2 > 0.0 && dist2.is_finite()) {
+            return None;
+        }
+        let dist = dist2.sqrt();
+        let wi = d / dist;
+        Some(LightSample {
+            p: self.position,
+            n: Vec3::ZERO,
+            primitive: 0,
+            wi,
+            dist,
+            radiance: self.intensity / dist2,
+            pdf_solid_angle: 1.0,
+            pdf_area: 1.0,
+            delta: true,
+        })
+    }
+
+    /// A uniform direction on the sphere (pdf 1/4π) from the light's position.
+    pub fn sample_le(&self, u2: Vec2) -> Option<EmissionSample> {
+        Some(EmissionSample {
+            origin: self.position,
+            direction: warp::square_to_sphere(u2),
+            n: Vec3::ZERO,
+            primitive: 0,
+            radiance: self.intensity,
+            pdf_pos: 1.0,
+            pdf_dir: warp::sphere_pdf(),
+            delta_pos: true,
+            delta_dir: false,
+        })
+    }
+
+    pub fn pdf_le(&self) -> (f32, f32) {
+        (1.0, warp::sphere_pdf())
+    }
+}

@@ -1,0 +1,407 @@
+//! Sampling points on the shapes that carry area lights, from the world-space shape data of
+//! the scene description:
+//!
+//! - triangle meshes: a triangle by area (a cdf over the triangles), then a uniform point
+//!   on it — uniform by area over the whole mesh;
+//! - analytic spheres: seen from outside, a uniform direction in the cone the sphere
+//!   subtends (uniform solid angle over the visible cap: no wasted samples on the far
+//!   side); from inside, uniform by area;
+//! - disks: uniform by area (a uniform point of the unit disk through the affine
+//!   `to_world`, whose Jacobian is constant).
+//!
+//! Normals follow the geometry module (and Mitsuba): counter-clockwise triangle winding
+//! (the loader has already applied `flip_normals` to meshes), outward sphere normals, the
+//! disk's local +z through the inverse transpose, and `flip_normals` negating the latter two.
+//! Whether a sampled point faces the reference point is for the caller (`area.rs`) to decide.
+
+use glam::{DMat4, DVec3, Mat4, Vec2, Vec3};
+
+use crate::light::distribution::Distribution1D;
+use crate::math::{Frame, PI, Transform, warp};
+use crate::scene::{ShapeDesc, ShapeGeometry, TriangleMesh};
+
+/// A point on a shape with its unit geometric normal (front side) and the triangle it lies
+/// on (0 for analytic shapes).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapePoint {
+    pub p: Vec3,
+    pub n: Vec3,
+    pub primitive: u32,
+}
+
+/// A point sampled as seen from a reference point, with its density in both measures.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShapeSample {
+    pub point: ShapePoint,
+    /// Density of the direction from the reference point, per steradian.
+    pub pdf_solid_angle: f32,
+    /// Density of the point, per unit area of the shape.
+    pub pdf_area: f32,
+}
+
+/// A shape ready for sampling.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ShapeSampler {
+    Mesh(MeshSampler),
+    Sphere(SphereSampler),
+    Disk(DiskSampler),
+}
+
+impl ShapeSampler {
+    /// Err(reason) when the shape has no area that could emit (no valid triangle, radius
+    /// not positive, singular disk transform).
+    pub fn new(shape: &ShapeDesc) -> Result<ShapeSampler, String> {
+        match &shape.geometry {
+            ShapeGeometry::Mesh(mesh) => MeshSampler::new(mesh).map(ShapeSampler::Mesh),
+            ShapeGeometry::Sphere { center, radius } => {
+                SphereSampler::new(*center, *radius, shape.flip_normals).map(ShapeSampler::Sphere)
+            }
+            ShapeGeometry::Disk { to_world } => {
+                DiskSampler::new(to_world, shape.flip_normals).map(ShapeSampler::Disk)
+            }
+        }
+    }
+
+    /// Surface area.
+    pub fn area(&self) -> f32 {
+        match self {
+            ShapeSampler::Mesh(m) => m.area,
+            ShapeSampler::Sphere(s) => 4.0 * PI * s.radius * s.radius,
+            ShapeSampler::Disk(d) => d.area,
+        }
+    }
+
+    /// A point uniformly distributed by area (density 1 / area).
+    pub fn sample_area(&self, u: Vec2) -> ShapePoint {
+        match self {
+            ShapeSampler::Mesh(m) => m.sample_area(u),
+            ShapeSampler::Sphere(s) => s.sample_area(u),
+            ShapeSampler::Disk(d) => d.sample_area(u),
+        }
+    }
+
+    /// A point sampled for the reference point `r` (the strategy of the module docs).
+    /// None when the point cannot be turned into a direction (it coincides with `r`, or is
+    /// seen exactly edge-on).
+    pub fn sample_from(&self, r: Vec3, u: Vec2) -> Option<ShapeSample> {
+        if let ShapeSampler::Sphere(s) = self
+            && s.sees_outside(r)
+        {
+            return s.sample_cone(r, u);
+        }
+        let point = self.sample_area(u);
+        let pdf_area = 1.0 / self.area();
+        let pdf_solid_angle = area_to_solid_angle(pdf_area, r, point.p, point.n);
+        (pdf_solid_angle > 0.0 && pdf_solid_angle.is_finite()).then_some(ShapeSample {
+            point,
+            pdf_solid_angle,
+            pdf_area,
+        })
+    }
+
+    /// The solid-angle density with which `sample_from(r, ·)` produces point `p` (normal
+    /// `n`) of this shape; 0 where that density is not finite.
+    pub fn pdf_from(&self, r: Vec3, p: Vec3, n: Vec3) -> f32 {
+        if let ShapeSampler::Sphere(s) = self
+            && s.sees_outside(r)
+        {
+            return s.cone_pdf(r);
+        }
+        let pdf = area_to_solid_angle(1.0 / self.area(), r, p, n);
+        if pdf.is_finite() { pdf } else { 0.0 }
+    }
+}
+
+/// Converts an area density at `p` (normal `n`) into a solid-angle density seen from `r`:
+/// pdf_A · d² / |cos θ| (0 when the distance is 0, infinite when seen edge-on).
+fn area_to_solid_angle(pdf_area: f32, r: Vec3, p: Vec3, n: Vec3) -> f32 {
+    let d = p - r;
+    let dist2 = d.length_squared();
+    if dist2.is_nan() || dist2 <= 0.0 {
+        return 0.0;
+    }
+    let cos = n.dot(d).abs() / dist2.sqrt();
+    pdf_area * dist2 / cos
+}
+
+/// Uniform-by-area sampling of a triangle mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeshSampler {
+    triangles: Vec<[Vec3; 3]>,
+    normals: Vec<Vec3>,
+    /// Index of each kept triangle in the mesh.
+    primitives: Vec<u32>,
+    /// Over the kept triangles, by area.
+    by_area: Distribution1D,
+    area: f32,
+}
+
+impl MeshSampler {
+    /// Keeps the triangles the ray caster keeps too (indices in range, finite vertices, a
+    /// normal that can be normalised), weighted by their area (computed in f64).
+    pub fn new(mesh: &TriangleMesh) -> Result<MeshSampler, String> {
+        let mut triangles = Vec::new();
+        let mut normals = Vec::new();
+        let mut primitives = Vec::new();
+        let mut areas = Vec::new();
+        let mut total = 0.0f64;
+        let n_vertices = mesh.positions.len();
+        for (pi, idx) in mesh.indices.iter().enumerate() {
+            if idx.iter().any(|&i| i as usize >= n_vertices) {
+                continue;
+            }
+            let v = idx.map(|i| mesh.positions[i as usize]);
+            let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+            if !(v.iter().all(|p| p.is_finite()) && ng.is_finite()) {
+                continue;
+            }
+            let [a, b, c] = v.map(|p| p.as_dvec3());
+            let area = 0.5 * (b - a).cross(c - a).length();
+            if !(area > 0.0 && area.is_finite()) {
+                continue;
+            }
+            total += area;
+            triangles.push(v);
+            normals.push(ng);
+            primitives.push(pi as u32);
+            areas.push(area as f32);
+        }
+        let by_area = Distribution1D::new(&areas)
+            .ok_or_else(|| "the emitting mesh has no triangle of positive area".to_string())?;
+        let area = total as f32;
+        if !(area > 0.0 && area.is_finite()) {
+            return Err(format!("the emitting mesh has an unusable area ({total})"));
+        }
+        Ok(MeshSampler {
+            triangles,
+            normals,
+            primitives,
+            by_area,
+            area,
+        })
+    }
+
+    pub fn area(&self) -> f32 {
+        self.area
+    }
+
+    /// Number of triangles kept for sampling.
+    pub fn triangle_count(&self) -> usize {
+        self.triangles.len()
+    }
+
+    fn sample_area(&self, u: Vec2) -> ShapePoint {
+        let (i, _, ux) = self.by_area.sample_discrete(u.x);
+        let b = warp::square_to_triangle(Vec2::new(ux, u.y));
+        let [v0, v1, v2] = self.triangles[i];
+        ShapePoint {
+            p: v0 * (1.0 - b.x - b.y) + v1 * b.x + v2 * b.y,
+            n: self.normals[i],
+            primitive: self.primitives[i],
+        }
+    }
+}
+
+/// An analytic sphere.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereSampler {
+    pub center: Vec3,
+    pub radius: f32,
+    /// Normals point inward.
+    pub flip_normals: bool,
+}
+
+impl SphereSampler {
+    pub fn new(center: Vec3, radius: f32, flip_normals: bool) -> Result<SphereSampler, String> {
+        if !(center.is_finite() && radius.is_finite() && radius > 0.0) {
+            return Err(format!(
+                "the emitting sphere needs a finite centre and a positive radius, got centre \
+                 {center:?} and radius {radius}"
+            ));
+        }
+        Ok(SphereSampler {
+            center,
+            radius,
+            flip_normals,
+        })
+    }
+
+    fn normal_at(&self, outward: Vec3) -> Vec3 {
+        if self.flip_normals { -outward } else { outward }
+    }
+
+    /// True when `r` is outside the sphere (the cone strategy applies).
+    fn sees_outside(&self, r: Vec3) -> bool {
+        (self.center - r).length_squared() > self.radius * self.radius
+    }
+
+    /// 1 − cos θ_max of the cone the sphere subtends from outside point `r`, computed as
+    /// sin²θ_max / (1 + cos θ_max) to keep its digits for small, distant spheres.
+    fn one_minus_cos_max(&self, r: Vec3) -> f64 {
+        let d2 = (self.center.as_dvec3() - r.as_dvec3()).length_squared();
+        let radius = self.radius as f64;
+        let sin2_max = (radius * radius / d2).min(1.0);
+        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+        sin2_max / (1.0 + cos_max)
+    }
+
+    /// The uniform density over the cone, 1 / (2π (1 − cos θ_max)).
+    fn cone_pdf(&self, r: Vec3) -> f32 {
+        (1.0 / (2.0 * std::f64::consts::PI * self.one_minus_cos_max(r))) as f32
+    }
+
+    fn sample_area(&self, u: Vec2) -> ShapePoint {
+        let w = warp::square_to_sphere(u);
+        ShapePoint {
+            p: self.center + w * self.radius,
+            n: self.normal_at(w),
+            primitive: 0,
+        }
+    }
+
+    /// A direction uniform in the subtended cone, turned into the point it first meets on
+    /// the sphere. The point is placed by its angle α at the centre rather than by a ray
+    /// intersection: with k = d/r = 1/sin θ_max, the law of sines in the triangle
+    /// (r, centre, p) gives cos α = k sin²θ + cos θ √(1 − k² sin²θ). Near the silhouette
+    /// the root cancels (k² sin²θ → 1), so this runs in f64: in f32 a far sphere's sampled
+    /// point could land ~10⁻⁴ rad past the silhouette, on the hidden side.
+    fn sample_cone(&self, r: Vec3, u: Vec2) -> Option<ShapeSample> {
+        let center = self.center.as_dvec3();
+        let radius = self.radius as f64;
+        let axis_v = r.as_dvec3() - center;
+        let d2 = axis_v.length_squared();
+        let d = d2.sqrt();
+        let axis = axis_v / d;
+        let sin2_max = (radius * radius / d2).min(1.0);
+        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+        let one_minus_cos_max = sin2_max / (1.0 + cos_max);
+        let one_minus_cos = u.x as f64 * one_minus_cos_max;
+        let sin2 = (one_minus_cos * (2.0 - one_minus_cos)).max(0.0);
+        let cos = 1.0 - one_minus_cos;
+        let k = d / radius;
+        let cos_alpha = (k * sin2 + cos * (1.0 - k * k * sin2).max(0.0).sqrt()).clamp(-1.0, 1.0);
+        let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+        let phi = 2.0 * std::f64::consts::PI * u.y as f64;
+        let frame = Frame::from_normal(axis.as_vec3());
+        let (s, t) = (frame.s.as_dvec3(), frame.t.as_dvec3());
+        let outward =
+            (s * (sin_alpha * phi.cos()) + t * (sin_alpha * phi.sin()) + axis * cos_alpha)
+                .normalize();
+        let p = (center + outward * radius).as_vec3();
+        let n = self.normal_at(outward.as_vec3());
+        let dist2 = (p - r).length_squared();
+        if dist2.is_nan() || dist2 <= 0.0 {
+            return None;
+        }
+        let pdf_solid_angle = self.cone_pdf(r);
+        let cos_light = n.dot(r - p).abs() / dist2.sqrt();
+        Some(ShapeSample {
+            point: ShapePoint { p, n, primitive: 0 },
+            pdf_solid_angle,
+            pdf_area: pdf_solid_angle * cos_light / dist2,
+        })
+    }
+}
+
+/// An analytic disk: the unit disk of the local xy plane under an affine `to_world`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DiskSampler {
+    to_world: DMat4,
+    /// Unit front normal.
+    pub n: Vec3,
+    area: f32,
+}
+
+impl DiskSampler {
+    /// The same normal as the ray caster: local +z through the inverse transpose (in f64),
+    /// negated by `flip_normals`. The area is π |M x̂ × M ŷ|.
+    pub fn new(to_world: &Transform, flip_normals: bool) -> Result<DiskSampler, String> {
+        let m: Mat4 = to_world.matrix;
+        let m64 = m.as_dmat4();
+        let det = m64.determinant();
+        if !(m.is_finite() && det.is_finite() && det != 0.0) {
+            return Err("the emitting disk's to_world is singular or not finite".to_string());
+        }
+        let inv = m64.inverse();
+        let n = DVec3::new(inv.x_axis.z, inv.y_axis.z, inv.z_axis.z);
+        let n = (n / n.length()).as_vec3().normalize();
+        let area =
+            std::f64::consts::PI * m64.x_axis.truncate().cross(m64.y_axis.truncate()).length();
+        if !(n.is_finite() && area > 0.0 && area.is_finite()) {
+            return Err("the emitting disk has no usable area or normal".to_string());
+        }
+        Ok(DiskSampler {
+            to_world: m64,
+            n: if flip_normals { -n } else { n },
+            area: area as f32,
+        })
+    }
+
+    pub fn area(&self) -> f32 {
+        self.area
+    }
+
+    fn sample_area(&self, u: Vec2) -> ShapePoint {
+        let q = warp::square_to_disk_concentric(u);
+        let p = self
+            .to_world
+            .transform_point3(DVec3::new(q.x as f64, q.y as f64, 0.0))
+            .as_vec3();
+        ShapePoint {
+            p,
+            n: self.n,
+            primitive: 0,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn cone_points_lie_on_the_sphere_and_face_the_reference() {
+        for (c, radius, r) in [
+            (Vec3::new(0.0, 0.0, 0.0), 1.0, Vec3::new(0.0, 0.0, 3.0)),
+            (
+                Vec3::new(10.0, -3.0, 2.0),
+                0.01,
+                Vec3::new(-90.0, 40.0, 7.0),
+            ),
+            (
+                Vec3::new(0.0, 0.0, 0.0),
+                1.0,
+                Vec3::new(0.0, 1.0 + 1e-4, 0.0),
+            ),
+        ] {
+            let s = SphereSampler::new(c, radius, false).unwrap();
+            for k in 0..256 {
+                let u = Vec2::new((k as f32 + 0.5) / 256.0, (k as f32 * 0.618).fract());
+                let smp = s.sample_cone(r, u).unwrap();
+                let on = ((smp.point.p - c).length() - radius).abs();
+                assert!(on <= 1e-5 * (radius + c.length()), "{on}");
+                assert!(smp.point.n.dot(r - smp.point.p) >= -1e-4 * radius);
+            }
+        }
+    }
+
+    #[test]
+    fn disk_area_of_a_scaled_disk() {
+        let t = Transform::new(Mat4::from_scale(Vec3::new(2.0, 3.0, 5.0))).unwrap();
+        let d = DiskSampler::new(&t, false).unwrap();
+        assert!((d.area() - 6.0 * PI).abs() < 1e-4);
+        assert_eq!(d.n, Vec3::Z);
+        let flipped = DiskSampler::new(&t, true).unwrap();
+        assert_eq!(flipped.n, -Vec3::Z);
+    }
+
+    #[test]
+    fn degenerate_meshes_are_refused() {
+        let mesh = TriangleMesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::X * 2.0],
+            indices: vec![[0, 1, 2], [0, 1, 7]],
+            ..TriangleMesh::default()
+        };
+        assert!(MeshSampler::new(&mesh).is_err());
+    }
+}
