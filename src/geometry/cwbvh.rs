@@ -131,6 +131,10 @@ impl<'a> Builder<'a> {
         let n2 = &self.bvh2.nodes;
         self.depth = self.depth.max(task.level);
         let (children, len) = choose_children(self.bvh2, task.binary);
+        // The size checks below read the children's children: overlap those misses.
+        for &c in &children[..len] {
+            prefetch_children(self.bvh2, c);
+        }
         let slots = order_children(self.bvh2, task.binary, &children[..len]);
         let (p, e_bits, e) = quantisation_frame(n2[task.binary as usize].aabb());
         let mut node = CwBvhNode {
@@ -182,27 +186,50 @@ impl<'a> Builder<'a> {
     }
 }
 
-/// Whether binary node `b` holds at most `MAX_LEAF` primitives (looks at a handful of
-/// nodes: every pending subtree holds at least one primitive).
+/// Whether binary node `b` holds at most `MAX_LEAF` = 3 primitives, reading as few nodes as
+/// possible (PLOC leaves hold one primitive, so two internal children mean at least four).
 fn is_small(bvh2: &Bvh2, b: u32) -> bool {
-    let mut stack = [0u32; 2 * MAX_LEAF as usize + 2];
-    stack[0] = b;
-    let (mut len, mut count) = (1usize, 0u32);
-    while len > 0 {
-        len -= 1;
-        let n = &bvh2.nodes[stack[len] as usize];
-        if n.is_leaf() {
-            count += n.prim_count;
-        } else {
-            stack[len] = n.first_index;
-            stack[len + 1] = n.first_index + 1;
-            len += 2;
-        }
-        if count + len as u32 > MAX_LEAF {
-            return false;
+    let n2 = &bvh2.nodes;
+    let node = &n2[b as usize];
+    if node.is_leaf() {
+        return node.prim_count <= MAX_LEAF;
+    }
+    let (l, r) = (
+        &n2[node.first_index as usize],
+        &n2[node.first_index as usize + 1],
+    );
+    match (l.is_leaf(), r.is_leaf()) {
+        (true, true) => l.prim_count + r.prim_count <= MAX_LEAF,
+        (false, false) => false,
+        (true, false) | (false, true) => {
+            let (leaf, inner) = if l.is_leaf() { (l, r) } else { (r, l) };
+            let (a, b) = (
+                &n2[inner.first_index as usize],
+                &n2[inner.first_index as usize + 1],
+            );
+            a.is_leaf() && b.is_leaf() && leaf.prim_count + a.prim_count + b.prim_count <= MAX_LEAF
         }
     }
-    true
+}
+
+/// Starts loading the children of binary node `b` (they are adjacent).
+fn prefetch_children(bvh2: &Bvh2, b: u32) {
+    let node = &bvh2.nodes[b as usize];
+    if !node.is_leaf()
+        && let Some(pair) = bvh2
+            .nodes
+            .get(node.first_index as usize..node.first_index as usize + 2)
+    {
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: prefetching never faults; the pointers are inside `pair`.
+        unsafe {
+            use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+            _mm_prefetch::<_MM_HINT_T0>(pair.as_ptr() as *const i8);
+            _mm_prefetch::<_MM_HINT_T0>((pair.as_ptr() as *const i8).add(64));
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        let _ = pair;
+    }
 }
 
 /// Up to eight binary nodes that become the children of the wide node made from `b`.
