@@ -13,6 +13,7 @@ pub mod io;
 pub mod light;
 pub mod material;
 pub mod math;
+pub mod path;
 pub mod render;
 pub mod sampler;
 pub mod scene;

@@ -146,22 +146,18 @@ fn run_render(args: RenderArgs) -> Result<()> {
 
     let stats = &result.stats;
     eprintln!(
-        "{}: {} passes, {} samples, {:.2} s ({:.3} M samples/s, {:.3} M rays/s) -> {} (+ {})",
+        "{}: {} passes, {} samples, {:.2} s ({:.3} M samples/s, {:.3} M rays/s), \
+         {} invalid samples dropped -> {} (+ {})",
         args.estimator,
         stats.passes,
         stats.samples,
         result.seconds,
         stats.samples as f64 / result.seconds / 1e6,
         stats.rays as f64 / result.seconds / 1e6,
+        stats.invalid_samples,
         output.display(),
         preview.display()
     );
-    if stats.invalid_samples > 0 {
-        eprintln!(
-            "warning: dropped {} samples that were NaN, infinite or negative",
-            stats.invalid_samples
-        );
-    }
     Ok(())
 }
 

@@ -58,10 +58,12 @@ fn one_and_two_threads_give_bit_identical_images() {
         .replace("<rfilter type=\"box\"/>", "");
     let text = text.replace("value=\"256\"", "value=\"40\"");
     let scene = Scene::build(mitsuba::load_str(&text, &path).unwrap()).unwrap();
-    let one = render_with_threads(&scene, "eyelight", 1, 3);
-    let two = render_with_threads(&scene, "eyelight", 2, 3);
-    assert_eq!(bits(&one), bits(&two));
-    assert!(one.pixels.iter().any(|p| !p.is_black()));
+    for estimator in ["eyelight", "pt"] {
+        let one = render_with_threads(&scene, estimator, 1, 3);
+        let two = render_with_threads(&scene, estimator, 2, 3);
+        assert_eq!(bits(&one), bits(&two), "{estimator}");
+        assert!(one.pixels.iter().any(|p| !p.is_black()), "{estimator}");
+    }
 }
 
 #[test]
@@ -72,19 +74,21 @@ fn every_builtin_scene_renders_a_finite_image() {
             continue;
         }
         let scene = load_small(&path, 24);
-        let image = render_with_threads(&scene, "eyelight", 2, 2);
-        let lit = image.pixels.iter().filter(|p| !p.is_black()).count();
-        assert!(
-            image.pixels.iter().all(|p| p.is_valid_radiance()),
-            "{}",
-            path.display()
-        );
-        // The box fills most of the frame: most pixels see a wall.
-        assert!(
-            lit * 2 > image.pixels.len(),
-            "{}: only {lit} lit pixels",
-            path.display()
-        );
+        for estimator in ["eyelight", "pt"] {
+            let image = render_with_threads(&scene, estimator, 2, 2);
+            let lit = image.pixels.iter().filter(|p| !p.is_black()).count();
+            assert!(
+                image.pixels.iter().all(|p| p.is_valid_radiance()),
+                "{}",
+                path.display()
+            );
+            // The box fills most of the frame: most pixels see a wall.
+            assert!(
+                lit * 2 > image.pixels.len(),
+                "{}: only {lit} lit pixels",
+                path.display()
+            );
+        }
     }
 }
 
@@ -233,4 +237,48 @@ fn millimetre_and_unit_cornell_boxes_render_alike() {
         "{differing} of {} pixels differ",
         a.pixels.len()
     );
+}
+
+/// Returns NaN, +∞ or a negative value in three of every four pixels (by x), 1 elsewhere.
+struct Poisoned;
+
+impl mltbench::estimator::camera_pass::CameraSampleFn for Poisoned {
+    fn radiance(
+        &self,
+        _: &Scene,
+        ray: &mltbench::geometry::Ray,
+        _: &mut mltbench::sampler::IndependentSampler,
+    ) -> (mltbench::math::Rgb, u64) {
+        use mltbench::math::Rgb;
+        // The camera sits on the z axis: the sign pattern of the direction picks a case.
+        let value = match (ray.d.x > 0.0, ray.d.y > 0.0) {
+            (true, true) => Rgb::splat(f32::NAN),
+            (true, false) => Rgb::new(1.0, f32::INFINITY, 1.0),
+            (false, true) => Rgb::new(1.0, -0.5, 1.0),
+            (false, false) => Rgb::splat(1.0),
+        };
+        (value, 1)
+    }
+}
+
+#[test]
+fn invalid_samples_are_counted_and_never_reach_the_film() {
+    use mltbench::estimator::Estimator;
+    use mltbench::estimator::camera_pass::CameraEstimator;
+    let scene = load_small(&scenes_dir().join("cbox.xml"), 16);
+    let mut est = CameraEstimator::new("poisoned", &scene, 1, Poisoned);
+    est.run_pass(&scene, 0);
+    est.run_pass(&scene, 1);
+    let stats = est.stats();
+    assert_eq!(stats.samples, 2 * 256);
+    // Three quadrants of the 16×16 image are poisoned (the box filter keeps samples in
+    // their own pixel, and no camera ray lies exactly on an axis here).
+    assert_eq!(stats.invalid_samples, 2 * 3 * 64);
+    let image = est.image();
+    let good = image
+        .pixels
+        .iter()
+        .filter(|p| **p == mltbench::math::Rgb::splat(1.0));
+    assert_eq!(good.count(), 64);
+    assert!(image.pixels.iter().all(|p| p.is_valid_radiance()));
 }

@@ -6,9 +6,11 @@
 
 use rayon::prelude::*;
 
+use super::{Estimator, Stats};
 use crate::camera::raster_in_pixel;
 use crate::film::{Film, FilmTile};
 use crate::geometry::Ray;
+use crate::image::Image;
 use crate::math::Rgb;
 use crate::sampler::{IndependentSampler, Sampler};
 use crate::scene::Scene;
@@ -72,4 +74,54 @@ pub fn camera_pass(
         total.invalid += counts.invalid;
     }
     total
+}
+
+/// An estimator that takes one camera sample per pixel and pass, computed by `S`
+/// (`eyelight`, `pt`): the film, the seed and the counters they all keep.
+pub struct CameraEstimator<S> {
+    name: &'static str,
+    film: Film,
+    seed: u64,
+    stats: Stats,
+    sample: S,
+}
+
+impl<S: CameraSampleFn + Send> CameraEstimator<S> {
+    pub fn new(name: &'static str, scene: &Scene, seed: u64, sample: S) -> Self {
+        let film = &scene.description.sensor.film;
+        CameraEstimator {
+            name,
+            film: Film::new(film.width, film.height, film.filter),
+            seed,
+            stats: Stats::default(),
+            sample,
+        }
+    }
+
+    /// The per-sample computation (its settings).
+    pub fn sample_fn(&self) -> &S {
+        &self.sample
+    }
+}
+
+impl<S: CameraSampleFn + Send> Estimator for CameraEstimator<S> {
+    fn name(&self) -> &str {
+        self.name
+    }
+
+    fn run_pass(&mut self, scene: &Scene, pass_index: u32) {
+        let counts = camera_pass(scene, &mut self.film, self.seed, pass_index, &self.sample);
+        self.stats.passes += 1;
+        self.stats.samples += counts.samples;
+        self.stats.rays += counts.rays;
+        self.stats.invalid_samples += counts.invalid;
+    }
+
+    fn image(&self) -> Image {
+        self.film.image(0.0)
+    }
+
+    fn stats(&self) -> Stats {
+        self.stats.clone()
+    }
 }

@@ -3,11 +3,8 @@
 //! shading normal (0.5 grey for non-diffuse BSDFs). Rays pass through `null` surfaces.
 //! A miss shows the constant environment emitter, if the scene has one, else black.
 
-use super::camera_pass::{CameraSampleFn, camera_pass};
-use super::{Estimator, Stats};
-use crate::film::Film;
+use super::camera_pass::{CameraEstimator, CameraSampleFn};
 use crate::geometry::Ray;
-use crate::image::Image;
 use crate::math::Rgb;
 use crate::sampler::IndependentSampler;
 use crate::scene::{BsdfDesc, EmitterDesc, Scene};
@@ -15,44 +12,34 @@ use crate::scene::{BsdfDesc, EmitterDesc, Scene};
 /// How many `null` surfaces a preview ray may cross before giving up.
 const MAX_NULL_CROSSINGS: u32 = 64;
 
-pub struct EyeLight {
-    film: Film,
-    seed: u64,
-    stats: Stats,
+/// The `eyelight` estimator.
+pub type EyeLight = CameraEstimator<Shade>;
+
+/// Makes `eyelight` for `scene`.
+pub fn new(scene: &Scene, seed: u64) -> EyeLight {
+    let background = scene
+        .description
+        .emitters
+        .iter()
+        .map(|e| match e {
+            EmitterDesc::Constant { radiance } => *radiance,
+            _ => Rgb::BLACK,
+        })
+        .fold(Rgb::BLACK, |a, b| a + b);
+    CameraEstimator::new("eyelight", scene, seed, Shade { background })
+}
+
+/// The preview shading of one camera ray.
+pub struct Shade {
     background: Rgb,
 }
 
-impl EyeLight {
-    pub fn new(scene: &Scene, seed: u64) -> Self {
-        let sensor = &scene.description.sensor;
-        let background = scene
-            .description
-            .emitters
-            .iter()
-            .map(|e| match e {
-                EmitterDesc::Constant { radiance } => *radiance,
-                _ => Rgb::BLACK,
-            })
-            .fold(Rgb::BLACK, |a, b| a + b);
-        EyeLight {
-            film: Film::new(sensor.film.width, sensor.film.height, sensor.film.filter),
-            seed,
-            stats: Stats::default(),
-            background,
-        }
-    }
-}
-
-struct Shade<'a> {
-    background: &'a Rgb,
-}
-
-impl CameraSampleFn for Shade<'_> {
+impl CameraSampleFn for Shade {
     fn radiance(&self, scene: &Scene, ray: &Ray, _: &mut IndependentSampler) -> (Rgb, u64) {
         let mut ray = *ray;
         for crossing in 0..=MAX_NULL_CROSSINGS {
             let Some(hit) = scene.geometry.intersect(&ray) else {
-                return (*self.background, crossing as u64 + 1);
+                return (self.background, crossing as u64 + 1);
             };
             let shape = &scene.description.shapes[hit.shape as usize];
             let bsdf = &scene.description.bsdfs[shape.bsdf];
@@ -71,30 +58,5 @@ impl CameraSampleFn for Shade<'_> {
             return (albedo * hit.ns.dot(toward_eye).abs(), crossing as u64 + 1);
         }
         (Rgb::BLACK, MAX_NULL_CROSSINGS as u64 + 1)
-    }
-}
-
-impl Estimator for EyeLight {
-    fn name(&self) -> &str {
-        "eyelight"
-    }
-
-    fn run_pass(&mut self, scene: &Scene, pass_index: u32) {
-        let shade = Shade {
-            background: &self.background,
-        };
-        let counts = camera_pass(scene, &mut self.film, self.seed, pass_index, &shade);
-        self.stats.passes += 1;
-        self.stats.samples += counts.samples;
-        self.stats.rays += counts.rays;
-        self.stats.invalid_samples += counts.invalid;
-    }
-
-    fn image(&self) -> Image {
-        self.film.image(0.0)
-    }
-
-    fn stats(&self) -> Stats {
-        self.stats.clone()
     }
 }

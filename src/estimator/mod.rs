@@ -8,6 +8,7 @@
 pub mod camera_pass;
 pub mod eyelight;
 pub mod params;
+pub mod pt;
 
 pub use params::Params;
 
@@ -38,13 +39,18 @@ pub trait Estimator: Send {
 }
 
 /// Names of the estimators this build knows, for `--help` and error messages.
-pub const ESTIMATOR_NAMES: &[&str] = &["eyelight"];
+pub const ESTIMATOR_NAMES: &[&str] = &["pt", "eyelight"];
 
 /// Makes the estimator called `name`, reading its parameters from `params`.
 /// Fails on an unknown name or a parameter the estimator does not have.
 pub fn create(name: &str, params: &Params, scene: &Scene, seed: u64) -> Result<Box<dyn Estimator>> {
     let estimator: Box<dyn Estimator> = match name {
-        "eyelight" => Box::new(eyelight::EyeLight::new(scene, seed)),
+        "eyelight" => Box::new(eyelight::new(scene, seed)),
+        "pt" => Box::new(pt::new(
+            scene,
+            seed,
+            pt::PtSettings::from_params(params, scene)?,
+        )),
         _ => {
             return Err(Error::usage(format!(
                 "unknown estimator '{name}' (known: {})",

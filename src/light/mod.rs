@@ -18,7 +18,7 @@
 //!   irradiance E for directional lights. No ray can hit them: `pdf_li` is 0.
 //! * **Lights at infinity** (`directional`, `constant`, `envmap`): their "point" is the unit
 //!   direction towards the light: `LightSample::p` = `wi`, and `LightPoint::p` passed to
-//!   `pdf_li` / `le` is the direction an escaped ray came from (−ray direction). For them
+//!   `pdf_li` / `le` is the direction of the escaped ray (pointing towards the light). For them
 //!   `pdf_area` repeats the solid-angle density (the direction plays the point's role).
 //! * **Emission** (light tracing, photons, BDPT light subpaths): `sample_le(u1, u2)`
 //!   returns a ray leaving the light with `pdf_pos` (area measure; 1 for a delta position)

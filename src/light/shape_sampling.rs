@@ -230,9 +230,14 @@ impl SphereSampler {
         if self.flip_normals { -outward } else { outward }
     }
 
-    /// True when `r` is outside the sphere (the cone strategy applies).
+    /// True when `r` is clearly outside the sphere (the cone strategy applies). A point on
+    /// the sphere itself (a path vertex on an emitting sphere, whose computed position may
+    /// land a rounding error outside) is sampled by area: from there only the inside is
+    /// visible, which the cone would miss. Area sampling is valid from anywhere, so the
+    /// margin only trades variance, never bias.
     fn sees_outside(&self, r: Vec3) -> bool {
-        (self.center - r).length_squared() > self.radius * self.radius
+        const MARGIN: f32 = 1.0 + 1e-3;
+        (self.center - r).length_squared() > self.radius * self.radius * MARGIN
     }
 
     /// 1 − cos θ_max of the cone the sphere subtends from outside point `r`, computed as

@@ -14,12 +14,18 @@ pub use description::*;
 use crate::camera::Camera;
 use crate::error::Result;
 use crate::geometry::Geometry;
+use crate::light::LightSet;
+use crate::material::Bsdf;
 
 /// A scene ready to render: immutable and shared by all threads.
 pub struct Scene {
     pub description: SceneDescription,
     pub geometry: Geometry,
     pub camera: Camera,
+    /// Every emitter, in the order of `description.emitters`, and the choice among them.
+    pub lights: LightSet,
+    /// The BSDFs, in the order of `description.bsdfs` (`ShapeDesc::bsdf` indexes both).
+    pub bsdfs: Vec<Bsdf>,
 }
 
 impl Scene {
@@ -29,13 +35,22 @@ impl Scene {
     }
 
     pub fn build(description: SceneDescription) -> Result<Scene> {
+        let lights = LightSet::build(&description)?;
+        let bsdfs = description.bsdfs.iter().map(Bsdf::from_desc).collect();
         let geometry = Geometry::build(&description.shapes);
         let camera = Camera::new(&description.sensor);
         Ok(Scene {
             description,
             geometry,
             camera,
+            lights,
+            bsdfs,
         })
+    }
+
+    /// The BSDF of shape `shape`.
+    pub fn bsdf_of_shape(&self, shape: u32) -> &Bsdf {
+        &self.bsdfs[self.description.shapes[shape as usize].bsdf]
     }
 
     pub fn width(&self) -> u32 {

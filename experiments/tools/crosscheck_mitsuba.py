@@ -1,0 +1,533 @@
+"""Cross-check an mltbench render against Mitsuba 3 on the same scene file.
+
+Renders SCENE.xml with Mitsuba 3 (pip package `mitsuba`) and with `mltbench render`, at the
+same samples per pixel, then prints per-channel means and their ratio (with a standard error),
+the relMSE between the two images (DESIGN.md §5) and both throughputs in camera paths per
+second. See CROSSCHECK.md beside this file for installing Mitsuba and reading the output.
+
+    /work/venv-mitsuba/bin/python experiments/tools/crosscheck_mitsuba.py \\
+        experiments/scenes/cbox.xml --spp 64 [--variant scalar_rgb|llvm_ad_rgb|both]
+
+Each Mitsuba variant renders in a child process (this same file, in worker mode), so a
+variant that crashes the interpreter (llvm_ad_rgb with a too-old system libLLVM aborts the
+process) is reported, and in the default `auto` mode replaced by scalar_rgb.
+"""
+
+import argparse
+import csv
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+REPO_ROOT = Path(__file__).resolve().parents[2]
+DEFAULT_BINARY = REPO_ROOT / "target" / "release" / "mltbench"
+VENV_HINT = (
+    "    python3 -m venv /work/venv-mitsuba\n"
+    '    /work/venv-mitsuba/bin/pip install "mitsuba>=3.9,<3.10" numpy\n'
+    "    /work/venv-mitsuba/bin/python " + " ".join(sys.argv)
+)
+LLVM_HINT = (
+    "llvm_ad_rgb needs a system libLLVM >= 16 (LLVM 15 aborts in the first render): "
+    "`apt-get install libllvm19`, or point DRJIT_LIBLLVM_PATH at a libLLVM.so"
+)
+# Largest number of camera paths Mitsuba's vectorised variant renders in one launch; more
+# spp than this is rendered as several passes (different seeds) and averaged.
+MAX_LANES = 1 << 24
+# Suffix of `mltbench render`'s last report line (src/main.rs).
+MLTBENCH_LINE = re.compile(
+    r"^(?P<est>\S+): (?P<passes>\d+) passes, (?P<samples>\d+) samples, (?P<secs>[0-9.]+) s "
+    r"\((?P<msps>[0-9.]+) M samples/s"
+)
+
+
+class Failure(Exception):
+    """An expected failure: printed as `error: ...` with no traceback."""
+
+
+# ---------------------------------------------------------------- worker (child process)
+
+
+def worker(job_file):
+    """Render one scene with one Mitsuba variant at each spp of the job; write EXRs + JSON."""
+    job = json.loads(Path(job_file).read_text())
+    import drjit as dr
+    import mitsuba as mi
+    import numpy as np
+
+    mi.set_variant(job["variant"])
+    mi.set_log_level(mi.LogLevel.Warn)
+    dr.set_thread_count(job["threads"])
+    scene_path = job["scene"]
+    spps = job["spps"]
+    # Scenes that declare `<default name="spp">` take the sample count as a parameter;
+    # passing a parameter the scene does not use is an error in Mitsuba.
+    declares_spp = re.search(r"\$spp\b", Path(scene_path).read_text()) is not None
+    t0 = time.perf_counter()
+    scene = mi.load_file(scene_path, spp=max(spps)) if declares_spp else mi.load_file(scene_path)
+    load_seconds = time.perf_counter() - t0
+    film = scene.sensors()[0].film()
+    width, height = (int(v) for v in film.crop_size())
+    rfilter = str(film.rfilter()).split("[")[0]
+    out = {
+        "variant": job["variant"],
+        "mitsuba": mi.__version__,
+        "drjit": dr.__version__,
+        "threads": dr.thread_count(),
+        "width": width,
+        "height": height,
+        "rfilter": rfilter,
+        "declares_spp": declares_spp,
+        "load_seconds": load_seconds,
+        "warmup_seconds": None,
+        "runs": [],
+    }
+
+    def render(spp):
+        # Split into launches of at most MAX_LANES paths; equal-spp passes average exactly.
+        lanes_per_spp = width * height
+        per_pass = max(1, min(spp, MAX_LANES // lanes_per_spp))
+        chunks = [per_pass] * (spp // per_pass) + ([spp % per_pass] if spp % per_pass else [])
+        total = None
+        for k, n in enumerate(chunks):
+            seed = (job["seed"] * 1000003 + k) % (1 << 32)
+            img = mi.render(scene, spp=n, seed=seed)
+            dr.eval(img)
+            dr.sync_thread()
+            arr = np.array(img, dtype=np.float64) * n
+            total = arr if total is None else total + arr
+        return (total / spp).astype(np.float32), len(chunks)
+
+    if not job["variant"].startswith("scalar"):
+        # The first render JIT-compiles the kernels; render once at 1 spp so the timed
+        # renders below find them in the kernel cache.
+        t0 = time.perf_counter()
+        render(1)
+        out["warmup_seconds"] = time.perf_counter() - t0
+    for spp in spps:
+        t0 = time.perf_counter()
+        img, passes = render(spp)
+        seconds = time.perf_counter() - t0
+        exr = Path(job["outdir"]) / f"mitsuba-{job['variant']}-spp{spp}.exr"
+        mi.Bitmap(img).write(str(exr))
+        out["runs"].append({"spp": spp, "seconds": seconds, "passes": passes, "exr": str(exr)})
+    Path(job["result"]).write_text(json.dumps(out))
+
+
+# ---------------------------------------------------------------- parent: running renders
+
+
+def run_mitsuba(args, variant, spps, outdir):
+    """Run the worker for one variant; returns its JSON result or raises Failure."""
+    job = {
+        "scene": str(args.scene),
+        "variant": variant,
+        "threads": args.threads,
+        "seed": args.seed,
+        "spps": spps,
+        "outdir": str(outdir),
+        "result": str(outdir / f"mitsuba-{variant}.json"),
+    }
+    job_file = outdir / f"job-{variant}.json"
+    job_file.write_text(json.dumps(job))
+    proc = subprocess.run(
+        [sys.executable, str(Path(__file__).resolve()), "--_worker", str(job_file)],
+        capture_output=True,
+        text=True,
+    )
+    job_file.unlink()
+    for line in proc.stderr.splitlines() + proc.stdout.splitlines():
+        if " WARN " in line:
+            print(f"  mitsuba {variant}: {line.strip()}")
+    if proc.returncode != 0 or not Path(job["result"]).exists():
+        how = (
+            f"was killed by signal {-proc.returncode}"
+            if proc.returncode < 0
+            else f"exited with code {proc.returncode}"
+        )
+        text = (proc.stderr + proc.stdout).strip()
+        lines = [ln for ln in text.splitlines() if ln.strip()]
+        llvm_errors = [ln for ln in lines if ln.startswith("LLVM ERROR")]
+        if llvm_errors:
+            # LLVM follows its error with a long dump of its selection DAG: leave that out.
+            tail = llvm_errors[0][:200] + "\n(LLVM's dump that followed is omitted)"
+        else:
+            tail = "\n".join(lines[-30:]) if lines else "(no output)"
+        msg = f"Mitsuba ({variant}) {how} on {args.scene}:\n{tail}"
+        if variant.startswith("llvm") and (
+            proc.returncode < 0 or "LLVM" in text or "Cannot select" in text
+        ):
+            msg += "\nhint: " + LLVM_HINT
+        raise Failure(msg)
+    return json.loads(Path(job["result"]).read_text())
+
+
+def run_mltbench(args, spp, outdir):
+    """Run `mltbench render`; returns (exr path, samples, seconds, M samples/s)."""
+    exr = outdir / f"mltbench-{args.estimator}-spp{spp}.exr"
+    cmd = [
+        str(args.mltbench),
+        "render",
+        str(args.scene),
+        "--estimator",
+        args.estimator,
+        "--spp",
+        str(spp),
+        "--threads",
+        str(args.threads),
+        "--seed",
+        str(args.seed),
+        "-o",
+        str(exr),
+    ]
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True)
+    except OSError as e:
+        raise Failure(f"cannot run {args.mltbench}: {e}")
+    if proc.returncode != 0:
+        raise Failure(
+            f"mltbench render failed (exit code {proc.returncode}):\n  {' '.join(cmd)}\n"
+            + (proc.stderr.strip() or "(no output on stderr)")
+        )
+    found = None
+    for line in proc.stderr.splitlines():
+        m = MLTBENCH_LINE.match(line.strip())
+        if m:
+            found = m
+        elif line.startswith("warning"):
+            print(f"  mltbench: {line.strip()}")
+    if found is None:
+        raise Failure(
+            "could not find the report line (`EST: N passes, N samples, T s (X M samples/s, "
+            "...`) in mltbench's stderr:\n" + proc.stderr.strip()
+        )
+    samples = int(found["samples"])
+    # The M samples/s figure has more significant digits than the seconds (2 decimals).
+    msps = float(found["msps"])
+    if msps <= 0:
+        msps = samples / max(float(found["secs"]), 1e-9) / 1e6
+    return exr, samples, float(found["secs"]), msps
+
+
+def read_rgb(path):
+    """An EXR as a float64 H x W x 3 array (alpha dropped, grey replicated)."""
+    import mitsuba as mi
+    import numpy as np
+
+    try:
+        bmp = mi.Bitmap(str(path))
+    except Exception as e:  # Mitsuba raises RuntimeError with a readable message
+        raise Failure(f"cannot read {path}: {e}")
+    fmt = bmp.pixel_format()
+    arr = np.array(bmp, copy=True).astype(np.float64)
+    if arr.ndim == 2:
+        arr = arr[:, :, None]
+    if fmt in (mi.Bitmap.PixelFormat.RGB, mi.Bitmap.PixelFormat.RGBA):
+        return arr[:, :, :3]
+    if fmt in (mi.Bitmap.PixelFormat.Y, mi.Bitmap.PixelFormat.YA):
+        return np.repeat(arr[:, :, :1], 3, axis=2)
+    raise Failure(f"{path}: unsupported pixel format {fmt}")
+
+
+# ---------------------------------------------------------------- parent: statistics
+
+
+def compare(x, y):
+    """x = mltbench image, y = Mitsuba image (the reference of relMSE)."""
+    import numpy as np
+
+    npix = x.shape[0] * x.shape[1]
+    xs = x.reshape(-1, 3)
+    ys = y.reshape(-1, 3)
+    mx, my = xs.mean(axis=0), ys.mean(axis=0)
+    # Standard error of a channel mean, pixels treated as independent samples: std/sqrt(n).
+    # This includes the image's own spatial variation, so it is a generous (large) sigma.
+    se_x = xs.std(axis=0, ddof=1) / math.sqrt(npix)
+    se_y = ys.std(axis=0, ddof=1) / math.sqrt(npix)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = mx / my
+        # Delta method for a ratio of independent estimates.
+        sigma = np.abs(ratio) * np.sqrt((se_x / mx) ** 2 + (se_y / my) ** 2)
+        # Paired: the per-pixel difference has zero mean if both images have the same
+        # expectation, and its spread is only the two renders' noise (no image structure).
+        sigma_paired = (xs - ys).std(axis=0, ddof=1) / math.sqrt(npix) / np.abs(my)
+    # DESIGN.md §5: relMSE = mean((x - y)^2 / (y^2 + 0.01)) over pixels and channels.
+    relmse = float(np.mean((x - y) ** 2 / (y * y + 0.01)))
+    nonfinite = int(np.count_nonzero(~np.isfinite(x))), int(np.count_nonzero(~np.isfinite(y)))
+    return {
+        "mean_x": mx,
+        "mean_y": my,
+        "ratio": ratio,
+        "sigma": sigma,
+        "sigma_paired": sigma_paired,
+        "relmse": relmse,
+        "nonfinite": nonfinite,
+    }
+
+
+def fit_spp(spps, relmses):
+    """Slope of log relMSE vs log spp, and the least-squares fit relMSE = a/spp + b."""
+    import numpy as np
+
+    s = np.array(spps, dtype=np.float64)
+    r = np.array(relmses, dtype=np.float64)
+    ok = r > 0
+    slope = float(np.polyfit(np.log(s[ok]), np.log(r[ok]), 1)[0]) if ok.sum() >= 2 else math.nan
+    a, b = np.linalg.lstsq(np.stack([1.0 / s, np.ones_like(s)], axis=1), r, rcond=None)[0]
+    return slope, float(a), float(b)
+
+
+# ---------------------------------------------------------------- parent: output
+
+
+def fmt3(values, spec):
+    return "  ".join(format(float(v), spec) for v in values)
+
+
+def print_block(variant, spp, cmp, mits, mrun, mlt, threads):
+    width, height = mits["width"], mits["height"]
+    paths = width * height * spp
+    mits_mps = paths / mrun["seconds"] / 1e6
+    _, mlt_samples, mlt_secs, mlt_mps = mlt
+    print(f"\n== spp {spp}: mltbench vs Mitsuba {variant} ==")
+    print(f"{'':22}{'R':>12}{'G':>12}{'B':>12}")
+    print(f"{'mean mltbench':22}" + "".join(f"{v:12.6g}" for v in cmp["mean_x"]))
+    print(f"{'mean mitsuba':22}" + "".join(f"{v:12.6g}" for v in cmp["mean_y"]))
+    print(f"{'ratio mltbench/mits.':22}" + "".join(f"{v:12.5f}" for v in cmp["ratio"]))
+    print(f"{'  sigma (std/sqrt n)':22}" + "".join(f"{v:12.5f}" for v in cmp["sigma"]))
+    print(f"{'  sigma (paired)':22}" + "".join(f"{v:12.5f}" for v in cmp["sigma_paired"]))
+    z = [(r - 1.0) / s if s > 0 else math.nan for r, s in zip(cmp["ratio"], cmp["sigma_paired"])]
+    print(f"{'  (ratio-1)/sigma_p':22}" + "".join(f"{v:12.2f}" for v in z))
+    print(f"relMSE (y = Mitsuba)  {cmp['relmse']:.6g}")
+    if any(cmp["nonfinite"]):
+        print(f"  warning: non-finite values: {cmp['nonfinite'][0]} in mltbench, "
+              f"{cmp['nonfinite'][1]} in Mitsuba")
+    print(
+        f"throughput mltbench   {mlt_mps:.3f} M paths/s ({mlt_mps / threads:.3f} per thread; "
+        f"{mlt_samples} paths in {mlt_secs:.2f} s)"
+    )
+    print(
+        f"throughput mitsuba    {mits_mps:.3f} M paths/s ({mits_mps / threads:.3f} per thread; "
+        f"{paths} paths in {mrun['seconds']:.2f} s"
+        + (f", {mrun['passes']} launches" if mrun["passes"] > 1 else "")
+        + ")"
+    )
+    print(f"throughput ratio      {mlt_mps / mits_mps:.3f} (mltbench / Mitsuba {variant})")
+    return mits_mps, mlt_mps
+
+
+CSV_FIELDS = [
+    "scene", "estimator", "variant", "spp", "threads", "seed", "width", "height",
+    "mean_ratio_r", "mean_ratio_g", "mean_ratio_b",
+    "sigma_r", "sigma_g", "sigma_b",
+    "sigma_paired_r", "sigma_paired_g", "sigma_paired_b",
+    "relmse", "mltbench_mpaths_s", "mitsuba_mpaths_s", "throughput_ratio",
+]
+
+
+def append_csv(path, row):
+    path = Path(path)
+    new = not path.exists() or path.stat().st_size == 0
+    try:
+        with path.open("a", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=CSV_FIELDS)
+            if new:
+                w.writeheader()
+            w.writerow(row)
+    except OSError as e:
+        raise Failure(f"cannot write {path}: {e}")
+
+
+# ---------------------------------------------------------------- parent: main
+
+
+def parse_args(argv):
+    p = argparse.ArgumentParser(
+        description="Render a scene with Mitsuba 3 and with mltbench (path tracing) at the "
+        "same spp; compare channel means, relMSE and throughput.",
+        epilog="See experiments/tools/CROSSCHECK.md.",
+    )
+    p.add_argument("scene", type=Path, help="Mitsuba 3 XML scene")
+    p.add_argument("--spp", type=int, default=64, help="samples per pixel (default 64)")
+    p.add_argument(
+        "--spp-list",
+        metavar="N,N,...",
+        help="render at each of these spp and tabulate relMSE against spp (replaces --spp)",
+    )
+    p.add_argument(
+        "--variant",
+        default="auto",
+        choices=["auto", "scalar_rgb", "llvm_ad_rgb", "both"],
+        help="Mitsuba variant (default auto: llvm_ad_rgb if it works, else scalar_rgb)",
+    )
+    p.add_argument(
+        "--mltbench",
+        type=Path,
+        default=DEFAULT_BINARY,
+        help="mltbench binary (default: target/release/mltbench in the repository)",
+    )
+    p.add_argument("--threads", type=int, default=2, help="threads for both renderers (default 2)")
+    p.add_argument("--seed", type=int, default=0, help="seed for both renderers (default 0)")
+    p.add_argument("--keep", type=Path, metavar="DIR", help="keep the EXR images in DIR")
+    p.add_argument("--csv", type=Path, metavar="FILE", help="append one row per comparison")
+    # Debug: test the plumbing with another mltbench estimator (e.g. eyelight).
+    p.add_argument("--estimator", default="pt", help=argparse.SUPPRESS)
+    args = p.parse_args(argv)
+    if args.spp_list:
+        try:
+            args.spps = sorted({int(s) for s in args.spp_list.split(",") if s.strip()})
+        except ValueError:
+            p.error(f"--spp-list: expected comma-separated integers, got {args.spp_list!r}")
+    else:
+        args.spps = [args.spp]
+    if not args.spps or min(args.spps) < 1:
+        p.error("spp must be at least 1")
+    if args.threads < 1:
+        p.error("--threads must be at least 1")
+    if not 0 <= args.seed < 1 << 32:
+        p.error("--seed must be in [0, 2^32)")
+    return args
+
+
+def check_setup(args):
+    try:
+        import numpy  # noqa: F401
+        import mitsuba as mi
+    except ImportError as e:
+        raise Failure(
+            f"{e.name or 'mitsuba'} is not installed for {sys.executable}. Install Mitsuba 3 "
+            f"in a virtual environment and run this script with its Python:\n{VENV_HINT}"
+        )
+    mi.set_variant("scalar_rgb")  # only for reading EXRs in this process
+    if not args.scene.is_file():
+        raise Failure(f"scene not found: {args.scene}")
+    args.scene = args.scene.resolve()
+    if not args.mltbench.is_file():
+        raise Failure(
+            f"mltbench binary not found at {args.mltbench}: build it with "
+            f"`cargo build --release` in {REPO_ROOT}, or pass --mltbench PATH"
+        )
+    if not os.access(args.mltbench, os.X_OK):
+        raise Failure(f"{args.mltbench} is not executable")
+    args.mltbench = args.mltbench.resolve()
+
+
+def main(argv):
+    if argv[:1] == ["--_worker"] and len(argv) == 2:
+        try:
+            worker(argv[1])
+        except Exception as e:  # the parent shows this message with the variant's name
+            print(f"error: {type(e).__name__}: {e}", file=sys.stderr)
+            return 2
+        return 0
+    args = parse_args(argv)
+    check_setup(args)
+    if args.keep:
+        args.keep.mkdir(parents=True, exist_ok=True)
+        tmp = None
+        outdir = args.keep.resolve()
+    else:
+        tmp = tempfile.TemporaryDirectory(prefix="crosscheck-")
+        outdir = Path(tmp.name)
+    try:
+        return crosscheck(args, outdir)
+    finally:
+        if tmp is not None:
+            tmp.cleanup()
+
+
+def crosscheck(args, outdir):
+    # Mitsuba first (one child per variant, all spp in it), then mltbench: never concurrently,
+    # so the throughputs are measured on an otherwise idle machine.
+    results = {}
+    if args.variant == "auto":
+        try:
+            results["llvm_ad_rgb"] = run_mitsuba(args, "llvm_ad_rgb", args.spps, outdir)
+        except Failure as e:
+            print("note: " + str(e).replace("\n", "\n  "))
+            print("note: falling back to scalar_rgb", flush=True)
+            results["scalar_rgb"] = run_mitsuba(args, "scalar_rgb", args.spps, outdir)
+    else:
+        variants = ["llvm_ad_rgb", "scalar_rgb"] if args.variant == "both" else [args.variant]
+        for v in variants:
+            results[v] = run_mitsuba(args, v, args.spps, outdir)
+    mlt = {spp: run_mltbench(args, spp, outdir) for spp in args.spps}
+
+    any_m = next(iter(results.values()))
+    print(f"scene     {args.scene} ({any_m['width']} x {any_m['height']}, "
+          f"{any_m['rfilter']}; spp {'passed as $spp' if any_m['declares_spp'] else 'set on render'})")
+    print(f"mltbench  {args.mltbench} --estimator {args.estimator}, "
+          f"{args.threads} threads, seed {args.seed}")
+    for v, m in results.items():
+        line = (f"mitsuba   {m['mitsuba']} (drjit {m['drjit']}) {v}, {m['threads']} threads; "
+                f"scene load {m['load_seconds']:.2f} s, not timed")
+        if m["warmup_seconds"] is not None:
+            line += (f"; JIT compilation excluded: a 1-spp warm-up render "
+                     f"({m['warmup_seconds']:.2f} s) ran before the timed renders")
+        print(line)
+    if any_m["rfilter"] != "BoxFilter":
+        print(f"note: the film uses {any_m['rfilter']}: neighbouring pixels share samples, so "
+              "the sigmas below (pixels taken as independent) are too small")
+
+    tables = {}
+    for spp in args.spps:
+        x = read_rgb(mlt[spp][0])
+        for v, m in results.items():
+            mrun = next(r for r in m["runs"] if r["spp"] == spp)
+            y = read_rgb(mrun["exr"])
+            if x.shape != y.shape:
+                raise Failure(f"image sizes differ: mltbench {x.shape[1]} x {x.shape[0]}, "
+                              f"Mitsuba {y.shape[1]} x {y.shape[0]}")
+            cmp = compare(x, y)
+            mits_mps, mlt_mps = print_block(v, spp, cmp, m, mrun, mlt[spp], args.threads)
+            tables.setdefault(v, []).append((spp, cmp["relmse"]))
+            if args.csv:
+                row = {
+                    "scene": str(args.scene), "estimator": args.estimator, "variant": v,
+                    "spp": spp, "threads": args.threads, "seed": args.seed,
+                    "width": m["width"], "height": m["height"],
+                    "relmse": f"{cmp['relmse']:.6g}",
+                    "mltbench_mpaths_s": f"{mlt_mps:.4f}", "mitsuba_mpaths_s": f"{mits_mps:.4f}",
+                    "throughput_ratio": f"{mlt_mps / mits_mps:.4f}",
+                }
+                for i, c in enumerate("rgb"):
+                    row[f"mean_ratio_{c}"] = f"{cmp['ratio'][i]:.6f}"
+                    row[f"sigma_{c}"] = f"{cmp['sigma'][i]:.6f}"
+                    row[f"sigma_paired_{c}"] = f"{cmp['sigma_paired'][i]:.6f}"
+                append_csv(args.csv, row)
+
+    if len(args.spps) > 1:
+        for v, rows in tables.items():
+            print(f"\n== relMSE against spp (Mitsuba {v}) ==")
+            print(f"{'spp':>8}{'relMSE':>14}{'relMSE x spp':>16}")
+            for spp, r in rows:
+                print(f"{spp:>8}{r:>14.6g}{r * spp:>16.6g}")
+            slope, a, b = fit_spp([s for s, _ in rows], [r for _, r in rows])
+            print(f"slope of log relMSE vs log spp: {slope:.3f} (-1 when both are unbiased "
+                  "and agree)")
+            print(f"fit relMSE = a/spp + b: a = {a:.4g}, b = {b:.3g} (b: the part that does "
+                  "not fall with spp)")
+    if args.keep:
+        print(f"\nimages kept in {outdir}")
+    return 0
+
+
+if __name__ == "__main__":
+    try:
+        sys.exit(main(sys.argv[1:]))
+    except Failure as e:
+        sys.stdout.flush()
+        print(f"error: {e}", file=sys.stderr)
+        sys.exit(1)
+    except KeyboardInterrupt:
+        sys.stdout.flush()
+        print("interrupted", file=sys.stderr)
+        sys.exit(130)
+    except BrokenPipeError:  # output piped into `head` and the like
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        sys.exit(1)

@@ -1,0 +1,409 @@
+//! The reference path tracer `pt` against closed forms (fixed seeds; tolerances in standard
+//! deviations measured from the renders themselves):
+//!
+//! * furnace: inside a closed, uniformly emitting diffuse enclosure of albedo a the radiance
+//!   is Le·Σ_{j<d} a^j for `max_depth` d, and Le/(1 − a) unbounded;
+//! * specular objects (mirror, glass, thin glass) inside such an enclosure are invisible;
+//! * an emitter seen directly shows exactly its radiance, from the front only;
+//! * direct illumination of a floor by a rectangular light matches Lambert's polygon formula.
+
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+use mltbench::camera::raster_in_pixel;
+use mltbench::estimator::{self, Params};
+use mltbench::image::Image;
+use mltbench::math::Rgb;
+use mltbench::render::{Budget, render};
+use mltbench::scene::{Scene, mitsuba};
+
+/// Standard deviations allowed before a test fails.
+const SIGMAS: f64 = 4.0;
+
+fn scene(xml: &str) -> Scene {
+    let desc = mitsuba::load_str(xml, Path::new("test-scene.xml")).expect("scene loads");
+    Scene::build(desc).expect("scene builds")
+}
+
+fn render_pt(scene: &Scene, params: &[&str], passes: u32, seed: u64) -> Image {
+    let params = Params::parse(params).unwrap();
+    let mut pt = estimator::create("pt", &params, scene, seed).unwrap();
+    let out = render(scene, pt.as_mut(), Budget::Passes(passes), |_, _| {});
+    assert_eq!(
+        out.stats.invalid_samples, 0,
+        "no sample may be NaN or negative"
+    );
+    out.image
+}
+
+/// Mean and standard error of channel `c` over the pixels `keep` selects (pixels are
+/// independent estimates under a box filter).
+fn pixel_mean(image: &Image, c: usize, keep: impl Fn(u32, u32) -> bool) -> (f64, f64) {
+    let mut values = Vec::new();
+    for y in 0..image.height {
+        for x in 0..image.width {
+            if keep(x, y) {
+                values.push(image.get(x, y)[c] as f64);
+            }
+        }
+    }
+    let n = values.len() as f64;
+    assert!(n >= 16.0, "too few pixels selected ({n})");
+    let mean = values.iter().sum::<f64>() / n;
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (n - 1.0);
+    (mean, (var / n).sqrt())
+}
+
+/// Relative rounding error of an f32 film accumulating thousands of samples: added to the
+/// statistical error, so that zero-variance cases (a lossless sphere in a uniform field)
+/// compare to float precision instead of to zero.
+const ROUNDING: f64 = 2e-5;
+
+fn assert_within_sigmas(what: &str, measured: (f64, f64), expected: f64) {
+    let (mean, se) = measured;
+    let se = se.hypot(ROUNDING * expected.abs());
+    let z = (mean - expected) / se.max(1e-12);
+    eprintln!("{what}: {mean:.5} ± {se:.5} (expected {expected:.5}, {z:+.2} σ)");
+    assert!(
+        z.abs() <= SIGMAS,
+        "{what}: {mean} differs from {expected} by {z:.2} σ (σ = {se})"
+    );
+}
+
+/// True when all of pixel (x, y) (its four corners) sees shape `shape` first.
+fn pixel_sees_only(scene: &Scene, x: u32, y: u32, shape: u32) -> bool {
+    [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+        .iter()
+        .all(|&(u, v)| {
+            let raster = raster_in_pixel(x, y, Vec2::new(u, v) * 0.999 + 0.0005);
+            let ray = scene.camera.generate_ray(raster);
+            scene
+                .geometry
+                .intersect(&ray)
+                .is_some_and(|h| h.shape == shape)
+        })
+}
+
+/// A camera at the origin looking down −z, 32×32 pixels, box filter.
+const CAMERA: &str = r#"
+    <sensor type="perspective">
+        <float name="fov" value="60"/>
+        <transform name="to_world"><lookat origin="0,0,0" target="0,0,-1" up="0,1,0"/></transform>
+        <film type="hdrfilm">
+            <integer name="width" value="32"/><integer name="height" value="32"/>
+            <rfilter type="box"/>
+        </film>
+    </sensor>"#;
+
+/// A closed enclosure around the camera, normals inward, emitting `le` with albedo `albedo`.
+fn enclosure(shape: &str, albedo: &str, le: &str) -> String {
+    let placement = match shape {
+        "sphere" => r#"<float name="radius" value="5"/>"#,
+        "cube" => r#"<transform name="to_world"><scale value="4"/></transform>"#,
+        _ => unreachable!(),
+    };
+    format!(
+        r#"<shape type="{shape}">{placement}
+            <boolean name="flip_normals" value="true"/>
+            <bsdf type="diffuse"><rgb name="reflectance" value="{albedo}"/></bsdf>
+            <emitter type="area"><rgb name="radiance" value="{le}"/></emitter>
+        </shape>"#
+    )
+}
+
+fn furnace(shape: &str, albedo: &str, le: &str, max_depth: i32, inside: &str) -> Scene {
+    scene(&format!(
+        r#"<scene version="3.0.0">
+            <integrator type="path"><integer name="max_depth" value="{max_depth}"/></integrator>
+            {CAMERA}
+            {}
+            {inside}
+        </scene>"#,
+        enclosure(shape, albedo, le)
+    ))
+}
+
+#[test]
+fn furnace_truncated_sums_for_each_max_depth() {
+    let (a, le) = (0.8f64, 1.0f64);
+    for shape in ["cube", "sphere"] {
+        for depth in [1, 2, 3, 5, 8] {
+            let scene = furnace(shape, "0.8", "1", depth, "");
+            let image = render_pt(&scene, &[], 16, 11 + depth as u64);
+            let expected: f64 = (0..depth).map(|j| le * a.powi(j)).sum();
+            for c in 0..3 {
+                assert_within_sigmas(
+                    &format!("{shape} furnace, max_depth {depth}, channel {c}"),
+                    pixel_mean(&image, c, |_, _| true),
+                    expected,
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn furnace_unbounded_depth_gives_le_over_one_minus_albedo() {
+    let albedo = [0.3f64, 0.6, 0.85];
+    let le = [1.0f64, 0.5, 2.0];
+    for shape in ["sphere", "cube"] {
+        let scene = furnace(shape, "0.3, 0.6, 0.85", "1, 0.5, 2", -1, "");
+        // Russian roulette from the first bounce too: it must not bias the estimate.
+        for rr_depth in ["rr_depth=5", "rr_depth=1"] {
+            let image = render_pt(&scene, &[rr_depth], 32, 5);
+            for c in 0..3 {
+                assert_within_sigmas(
+                    &format!("{shape} furnace, unbounded, {rr_depth}, channel {c}"),
+                    pixel_mean(&image, c, |_, _| true),
+                    le[c] / (1.0 - albedo[c]),
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn specular_objects_vanish_in_a_uniform_enclosure() {
+    // Le = 1, albedo 0.5: the radiance is 2 everywhere, through any lossless specular object.
+    let objects = [
+        (
+            "mirror",
+            r#"<bsdf type="conductor"><string name="material" value="none"/></bsdf>"#,
+        ),
+        (
+            "glass",
+            r#"<bsdf type="dielectric"><float name="int_ior" value="1.5"/></bsdf>"#,
+        ),
+        (
+            "dense glass",
+            r#"<bsdf type="dielectric"><string name="int_ior" value="diamond"/></bsdf>"#,
+        ),
+        ("thin glass", r#"<bsdf type="thindielectric"/>"#),
+    ];
+    for (name, bsdf) in objects {
+        for shape in ["sphere", "cube"] {
+            let inside = format!(
+                r#"<shape type="sphere"><point name="center" x="0" y="0" z="-2.5"/>
+                       <float name="radius" value="1.2"/>{bsdf}</shape>"#
+            );
+            let scene = furnace(shape, "0.5", "1", -1, &inside);
+            let image = render_pt(&scene, &[], 32, 3);
+            for c in 0..3 {
+                assert_within_sigmas(
+                    &format!("{name} in a {shape} furnace, channel {c}"),
+                    pixel_mean(&image, c, |x, y| pixel_sees_only(&scene, x, y, 1)),
+                    2.0,
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn emitters_seen_directly_show_their_radiance_from_the_front_only() {
+    // A black emitter facing the camera on the left, one facing away on the right.
+    let scene = scene(&format!(
+        r#"<scene version="3.0.0">
+            {CAMERA}
+            <bsdf type="diffuse" id="black"><rgb name="reflectance" value="0"/></bsdf>
+            <shape type="rectangle">
+                <transform name="to_world"><translate x="-1.1" z="-2"/></transform>
+                <ref id="black"/>
+                <emitter type="area"><rgb name="radiance" value="3, 2, 0.5"/></emitter>
+            </shape>
+            <shape type="rectangle">
+                <transform name="to_world"><rotate y="1" angle="180"/><translate x="1.1" z="-2"/></transform>
+                <ref id="black"/>
+                <emitter type="area"><rgb name="radiance" value="7"/></emitter>
+            </shape>
+            <emitter type="point"><point name="position" x="0" y="0" z="-1"/>
+                <rgb name="intensity" value="5"/></emitter>
+        </scene>"#
+    ));
+    let image = render_pt(&scene, &[], 4, 1);
+    let (mut front, mut back) = (0, 0);
+    for y in 0..32 {
+        for x in 0..32 {
+            let v = image.get(x, y);
+            if pixel_sees_only(&scene, x, y, 0) {
+                front += 1;
+                for (c, le) in [3.0f32, 2.0, 0.5].into_iter().enumerate() {
+                    assert!((v[c] - le).abs() <= 1e-5 * le, "pixel ({x},{y}) = {v:?}");
+                }
+            } else if pixel_sees_only(&scene, x, y, 1) {
+                back += 1;
+                assert_eq!(v, Rgb::BLACK, "the back of an emitter is dark at ({x},{y})");
+            }
+        }
+    }
+    assert!(
+        front > 20 && back > 20,
+        "{front} front and {back} back pixels"
+    );
+}
+
+/// A camera looking down at the floor y = −1 from under the Cornell box light, 16×16 pixels.
+const FLOOR_CAMERA: &str = r#"
+    <sensor type="perspective">
+        <float name="fov" value="28"/>
+        <transform name="to_world"><lookat origin="0,0.9,1.2" target="0,-1,-0.1" up="0,1,0"/></transform>
+        <film type="hdrfilm">
+            <integer name="width" value="16"/><integer name="height" value="16"/>
+            <rfilter type="box"/>
+        </film>
+    </sensor>"#;
+
+/// Irradiance at `p` (normal `n`) from a uniform Lambertian polygon of unit radiance:
+/// Lambert's formula E = ½ Σ_i Θ_i (n · γ̂_i), Θ_i the angle the edge v_i v_{i+1} subtends
+/// at p and γ̂_i the unit normal of the plane through p and that edge (Arvo 1995, eq. 2).
+/// Mean and standard error of pixel (x, y), channel c, over independent runs.
+fn mean_over_runs(runs: &[Image], x: u32, y: u32, c: usize) -> (f64, f64) {
+    let values: Vec<f64> = runs.iter().map(|im| im.get(x, y)[c] as f64).collect();
+    let k = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / k;
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (k - 1.0);
+    (mean, (var / k).sqrt())
+}
+
+/// The average of `f` over the points of the floor plane y = −1 that pixel (x, y) sees
+/// (16×16 stratified camera rays): what a box-filtered pixel converges to when the floor's
+/// radiance is `f`.
+fn floor_pixel_average(scene: &Scene, x: u32, y: u32, f: impl Fn(Vec3) -> f64) -> f64 {
+    let mut sum = 0.0;
+    for j in 0..16 {
+        for i in 0..16 {
+            let u = Vec2::new((i as f32 + 0.5) / 16.0, (j as f32 + 0.5) / 16.0);
+            let ray = scene.camera.generate_ray(raster_in_pixel(x, y, u));
+            let t = (-1.0 - ray.o.y) / ray.d.y;
+            let p = ray.at(t);
+            assert!(
+                t > 0.0 && p.x.abs() < 1.0 && p.z.abs() < 1.0,
+                "pixel sees the floor"
+            );
+            sum += f(p);
+        }
+    }
+    sum / 256.0
+}
+
+fn polygon_irradiance(p: Vec3, n: Vec3, vertices: &[Vec3]) -> f64 {
+    let mut sum = 0.0f64;
+    for i in 0..vertices.len() {
+        let a = (vertices[i] - p).as_dvec3().normalize();
+        let b = (vertices[(i + 1) % vertices.len()] - p)
+            .as_dvec3()
+            .normalize();
+        let theta = a.dot(b).clamp(-1.0, 1.0).acos();
+        sum += theta * n.as_dvec3().dot(a.cross(b).normalize());
+    }
+    0.5 * sum.abs()
+}
+
+#[test]
+fn floor_irradiance_under_a_rectangle_light_matches_lamberts_formula() {
+    // The Cornell box's floor and light (experiments/scenes/cbox.xml), nothing else; direct
+    // lighting only. Floor radiance = ρ/π · Le · E_unit.
+    let (rho, le) = (0.6f64, [18.387f64, 13.9873, 6.75357]);
+    let scene = scene(&format!(
+        r#"<scene version="3.0.0">
+            <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+            {FLOOR_CAMERA}
+            <shape type="rectangle">
+                <transform name="to_world">
+                    <scale x="0.23" y="0.19"/><rotate x="1" angle="90"/><translate y="0.99"/>
+                </transform>
+                <bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>
+                <emitter type="area"><rgb name="radiance" value="18.387, 13.9873, 6.75357"/></emitter>
+            </shape>
+            <shape type="rectangle">
+                <transform name="to_world"><rotate x="1" angle="-90"/><translate y="-1"/></transform>
+                <bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf>
+            </shape>
+        </scene>"#
+    ));
+    let light = [
+        Vec3::new(-0.23, 0.99, -0.19),
+        Vec3::new(0.23, 0.99, -0.19),
+        Vec3::new(0.23, 0.99, 0.19),
+        Vec3::new(-0.23, 0.99, 0.19),
+    ];
+    // Independent runs give each pixel's mean and standard error.
+    let runs: Vec<Image> = (0..16)
+        .map(|k| render_pt(&scene, &[], 16, 100 + k))
+        .collect();
+    let pixels = [(8, 8), (4, 4), (12, 5), (3, 12), (8, 14), (13, 13)];
+    for (x, y) in pixels {
+        let e = floor_pixel_average(&scene, x, y, |p| polygon_irradiance(p, Vec3::Y, &light));
+        for (c, le) in le.into_iter().enumerate() {
+            assert_within_sigmas(
+                &format!("floor pixel ({x},{y}) channel {c}"),
+                mean_over_runs(&runs, x, y, c),
+                rho / std::f64::consts::PI * le * e,
+            );
+        }
+    }
+}
+
+#[test]
+fn floor_under_a_point_light_follows_the_inverse_square_law() {
+    // E = I cos θ / d² (a delta light: next-event estimation only).
+    let (rho, intensity, light) = (0.5f64, 4.0f64, Vec3::new(0.3, 0.5, -0.2));
+    let scene = scene(&format!(
+        r#"<scene version="3.0.0">
+            {FLOOR_CAMERA}
+            <emitter type="point"><point name="position" x="0.3" y="0.5" z="-0.2"/>
+                <rgb name="intensity" value="4"/></emitter>
+            <shape type="rectangle">
+                <transform name="to_world"><rotate x="1" angle="-90"/><translate y="-1"/></transform>
+                <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf>
+            </shape>
+        </scene>"#
+    ));
+    let image = render_pt(&scene, &[], 4, 9);
+    for (x, y) in [(8, 8), (2, 3), (14, 12)] {
+        let expected = floor_pixel_average(&scene, x, y, |p| {
+            let d = light - p;
+            intensity * (d.y / d.length()) as f64 / d.length_squared() as f64
+        }) * rho
+            / std::f64::consts::PI;
+        // The only randomness is the position inside the pixel: compare to 1%.
+        let v = image.get(x, y)[0] as f64;
+        assert!(
+            (v / expected - 1.0).abs() < 0.01,
+            "pixel ({x},{y}) = {v}, expected {expected}"
+        );
+    }
+}
+
+#[test]
+fn uniform_environment_lights_a_convex_diffuse_object_to_its_albedo() {
+    // A convex object never sees itself: under a constant environment L its radiance is
+    // a·L for any depth ≥ 2. A glass sphere alone under the same sky is invisible.
+    let sphere = |bsdf: &str| {
+        scene(&format!(
+            r#"<scene version="3.0.0">
+                {CAMERA}
+                <emitter type="constant"><rgb name="radiance" value="1.5"/></emitter>
+                <shape type="sphere"><point name="center" x="0.3" y="0" z="-3"/>
+                    <float name="radius" value="1"/>{bsdf}</shape>
+            </scene>"#
+        ))
+    };
+    let diffuse =
+        sphere(r#"<bsdf type="diffuse"><rgb name="reflectance" value="0.25, 0.5, 0.75"/></bsdf>"#);
+    let glass = sphere(r#"<bsdf type="dielectric"><float name="int_ior" value="1.5"/></bsdf>"#);
+    let diffuse_image = render_pt(&diffuse, &[], 32, 4);
+    let glass_image = render_pt(&glass, &[], 32, 4);
+    for (c, a) in [0.25, 0.5, 0.75].into_iter().enumerate() {
+        assert_within_sigmas(
+            &format!("diffuse sphere under the sky, channel {c}"),
+            pixel_mean(&diffuse_image, c, |x, y| pixel_sees_only(&diffuse, x, y, 0)),
+            a * 1.5,
+        );
+        assert_within_sigmas(
+            &format!("glass sphere under the sky, channel {c}"),
+            pixel_mean(&glass_image, c, |x, y| pixel_sees_only(&glass, x, y, 0)),
+            1.5,
+        );
+    }
+}
