@@ -52,6 +52,10 @@ struct RenderArgs {
     /// Estimator parameter, repeatable: --set rr_depth=5 --set mis=power.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     set: Vec<String>,
+    /// Scene parameter, repeatable: -D res=64 sets the scene's <default name="res">
+    /// (as Mitsuba's -D). Naming a parameter the scene does not declare is an error.
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE")]
+    define: Vec<String>,
     /// Output EXR. Default: <scene name>.exr in the working directory. A PNG preview is
     /// written beside it.
     #[arg(short, long, value_name = "OUT.exr")]
@@ -99,7 +103,8 @@ fn run_render(args: RenderArgs) -> Result<()> {
         )));
     }
 
-    let description = mitsuba::load_file(&args.scene)?;
+    let scene_params = parse_defines(&args.define)?;
+    let description = mitsuba::load_file_with(&args.scene, &scene_params)?;
     for warning in &description.warnings {
         eprintln!("warning: {warning}");
     }
@@ -159,6 +164,19 @@ fn run_render(args: RenderArgs) -> Result<()> {
         preview.display()
     );
     Ok(())
+}
+
+/// `NAME=VALUE` pairs of `-D`.
+fn parse_defines(defines: &[String]) -> Result<Vec<(String, String)>> {
+    defines
+        .iter()
+        .map(|d| match d.split_once('=') {
+            Some((name, value)) if !name.trim().is_empty() => {
+                Ok((name.trim().to_string(), value.trim().to_string()))
+            }
+            _ => Err(Error::usage(format!("-D expects NAME=VALUE, got '{d}'"))),
+        })
+        .collect()
 }
 
 /// `<scene file stem>.exr` in the working directory.

@@ -1717,3 +1717,24 @@ fn circular_references_and_deep_nesting_are_errors_not_crashes() {
     let (message, _) = load_err("deep", &with_sphere(&deep));
     assert!(message.contains("nested deeper"), "{message}");
 }
+
+#[test]
+fn parameters_set_from_outside_replace_defaults_and_unknown_ones_are_errors() {
+    let text = r#"<scene version="3.0.0">
+        <default name="res" value="256"/>
+        <sensor type="perspective"><film type="hdrfilm">
+            <integer name="width" value="$res"/><integer name="height" value="$res"/>
+        </film></sensor>
+        <shape type="sphere"/>
+    </scene>"#;
+    let path = std::path::Path::new("defines.xml");
+    let set = |k: &str, v: &str| vec![(k.to_string(), v.to_string())];
+    let desc = mltbench::scene::mitsuba::load_str_with(text, path, &set("res", "32")).unwrap();
+    assert_eq!((desc.sensor.film.width, desc.sensor.film.height), (32, 32));
+    let desc = mltbench::scene::mitsuba::load_str_with(text, path, &[]).unwrap();
+    assert_eq!(desc.sensor.film.width, 256);
+    let err = mltbench::scene::mitsuba::load_str_with(text, path, &set("rez", "32"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("defines.xml") && err.contains("rez"), "{err}");
+}

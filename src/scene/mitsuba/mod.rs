@@ -36,9 +36,24 @@ pub fn load_file(path: &Path) -> Result<SceneDescription> {
     load_str(&text, path)
 }
 
+/// Reads a scene file with some of its `<default>` parameters set (Mitsuba's `-D`).
+pub fn load_file_with(path: &Path, params: &[(String, String)]) -> Result<SceneDescription> {
+    let text = xml::read_text(path)?;
+    load_str_with(&text, path, params)
+}
+
 /// Reads a scene from text; `path` names it in messages and resolves relative file names.
 pub fn load_str(text: &str, path: &Path) -> Result<SceneDescription> {
-    let tree = xml::parse_scene(text, path)?;
+    load_str_with(text, path, &[])
+}
+
+/// `load_str` with `<default>` parameters set from outside.
+pub fn load_str_with(
+    text: &str,
+    path: &Path,
+    params: &[(String, String)],
+) -> Result<SceneDescription> {
+    let tree = xml::parse_scene_with(text, path, params)?;
     let mut builder = Builder::new(&tree, path);
     builder.build()?;
     Ok(builder.desc)

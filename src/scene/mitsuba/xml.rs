@@ -237,8 +237,14 @@ pub(super) fn read_text(path: &Path) -> Result<String> {
     }
 }
 
-/// Builds the expanded tree of the scene `text` read from `path`.
-pub(super) fn parse_scene(text: &str, path: &Path) -> Result<Tree> {
+/// Builds the expanded tree of the scene `text` read from `path`, with parameters set from
+/// outside (Mitsuba's `-D name=value`; none for the file as written): each replaces the value of the scene's `<default name>`; a name the scene does not declare
+/// is an error (a misspelt parameter must not be ignored).
+pub(super) fn parse_scene_with(
+    text: &str,
+    path: &Path,
+    overrides: &[(String, String)],
+) -> Result<Tree> {
     if let Some(offset) = text.find('\0') {
         let line = 1 + text[..offset].matches('\n').count() as u32;
         return Err(Error::input(
@@ -259,7 +265,8 @@ pub(super) fn parse_scene(text: &str, path: &Path) -> Result<Tree> {
             aliases: HashMap::new(),
             path_folders: Vec::new(),
         },
-        defaults: Vec::new(),
+        defaults: overrides.to_vec(),
+        declared: Vec::new(),
         include_stack: vec![path.to_path_buf()],
         depth: 0,
     };
@@ -293,6 +300,17 @@ pub(super) fn parse_scene(text: &str, path: &Path) -> Result<Tree> {
     });
     reader.tree.root = 0;
     reader.expand_children(&doc, root, 0, 0, Kind::Scene)?;
+    if let Some((name, _)) = overrides
+        .iter()
+        .find(|(name, _)| !reader.declared.contains(name))
+    {
+        return Err(Error::input(
+            Location::file(path),
+            format!(
+                "parameter \"{name}\" was set, but the scene declares no <default name=\"{name}\">"
+            ),
+        ));
+    }
     Ok(reader.tree)
 }
 
@@ -370,6 +388,8 @@ struct Reader {
     tree: Tree,
     /// `<default>` parameters in declaration order (the first declaration of a name wins).
     defaults: Vec<(String, String)>,
+    /// Names of the `<default>` elements read so far.
+    declared: Vec<String>,
     include_stack: Vec<PathBuf>,
     /// Current element nesting depth (includes count as the elements they hold).
     depth: usize,
@@ -495,6 +515,7 @@ impl Reader {
                 if name.is_empty() {
                     return Err(Error::input(location(), "<default> needs a non-empty name"));
                 }
+                self.declared.push(name.clone());
                 if !self.defaults.iter().any(|(n, _)| *n == name) {
                     self.defaults
                         .push((name, attr("value").unwrap_or_default()));
