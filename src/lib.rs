@@ -11,6 +11,7 @@ pub mod geometry;
 pub mod image;
 pub mod io;
 pub mod light;
+pub mod experiment;
 pub mod material;
 pub mod math;
 pub mod path;

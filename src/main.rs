@@ -7,6 +7,7 @@ use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
 
 use mltbench::estimator::{self, ESTIMATOR_NAMES, Params};
+use mltbench::experiment::{self, Experiment};
 use mltbench::render::{Budget, render};
 use mltbench::scene::{Scene, mitsuba};
 use mltbench::{Error, Result, io};
@@ -28,6 +29,91 @@ enum Command {
     /// The image is bit-identical for the same scene, estimator, parameters, seed and
     /// number of passes, whatever --threads is.
     Render(RenderArgs),
+    /// Run a named experiment (experiments/NAME.toml, or a path to a .toml file): every
+    /// estimator × run to its checkpoints, against the reference, then the report under
+    /// results/NAME/. Resumes where an earlier run stopped unless --fresh.
+    Run(RunArgs),
+    /// List the experiments with one-line descriptions.
+    List,
+    /// Merge the cells present under results/NAME/ into the summary, plots and README
+    /// (after `run --cell K` jobs, e.g. a Slurm array).
+    Report(ReportArgs),
+    /// Render a reference: two independent halves averaged, with the noise estimate from
+    /// their difference written to OUT.json beside OUT.exr.
+    Reference(ReferenceArgs),
+    /// Print relMSE, RMSE and MAPE (DESIGN.md §5) of an image against a reference.
+    Compare(CompareArgs),
+}
+
+#[derive(clap::Args)]
+struct RunArgs {
+    /// Experiment name or path to its .toml file.
+    experiment: String,
+    /// Scale budgets down and cap runs as the experiment's [quick] table says (a smoke
+    /// run; results go to results/NAME-quick/).
+    #[arg(long)]
+    quick: bool,
+    /// Delete earlier results of this experiment and start over.
+    #[arg(long)]
+    fresh: bool,
+    /// List the experiment's independent (estimator, run) cells and exit.
+    #[arg(long, conflicts_with = "cell")]
+    cells: bool,
+    /// Run only cell K (see --cells) and write only its files; `report` merges them.
+    #[arg(long, value_name = "K")]
+    cell: Option<usize>,
+    /// Only make sure the reference exists (renders it if needed) and exit: run this once
+    /// before spreading cells over a cluster.
+    #[arg(long, conflicts_with_all = ["cell", "cells"])]
+    prepare: bool,
+    /// Folder of results (default: results).
+    #[arg(long, value_name = "DIR", default_value = "results")]
+    results: PathBuf,
+    /// Worker threads (default: all cores). Does not change the images.
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+}
+
+#[derive(clap::Args)]
+struct ReportArgs {
+    /// Experiment name or path to its .toml file.
+    experiment: String,
+    /// Report on the --quick results.
+    #[arg(long)]
+    quick: bool,
+    #[arg(long, value_name = "DIR", default_value = "results")]
+    results: PathBuf,
+}
+
+#[derive(clap::Args)]
+struct ReferenceArgs {
+    /// The scene: a Mitsuba 3 XML file.
+    scene: PathBuf,
+    #[arg(short, long, value_name = "NAME", help = estimator_help())]
+    estimator: String,
+    /// Passes in all (each half renders half of them).
+    #[arg(long, value_name = "N", conflicts_with = "time", required_unless_present = "time")]
+    spp: Option<u32>,
+    /// Seconds in all (each half renders half of them).
+    #[arg(long, value_name = "SECONDS")]
+    time: Option<f64>,
+    #[arg(long, default_value_t = 0)]
+    seed: u64,
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+    #[arg(long = "set", value_name = "KEY=VALUE")]
+    set: Vec<String>,
+    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE")]
+    define: Vec<String>,
+    /// Output EXR (default: <scene name>-reference.exr); OUT.json and OUT.png beside it.
+    #[arg(short, long, value_name = "OUT.exr")]
+    output: Option<PathBuf>,
+}
+
+#[derive(clap::Args)]
+struct CompareArgs {
+    image: PathBuf,
+    reference: PathBuf,
 }
 
 #[derive(clap::Args)]
@@ -70,6 +156,11 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match cli.command {
         Command::Render(args) => run_render(args),
+        Command::Run(args) => run_experiment(args),
+        Command::List => list_experiments(),
+        Command::Report(args) => report_experiment(args),
+        Command::Reference(args) => render_reference(args),
+        Command::Compare(args) => compare(args),
     };
     match outcome {
         Ok(()) => ExitCode::SUCCESS,
@@ -163,6 +254,156 @@ fn run_render(args: RenderArgs) -> Result<()> {
         output.display(),
         preview.display()
     );
+    Ok(())
+}
+
+fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .build()
+        .map_err(|e| Error::usage(format!("cannot start {threads:?} threads: {e}")))
+}
+
+fn experiment_bar() -> ProgressBar {
+    let bar = ProgressBar::new(1);
+    bar.set_style(
+        ProgressStyle::with_template("{elapsed_precise} [{bar:30}] {percent}% ETA {eta} {msg}")
+            .expect("valid template")
+            .progress_chars("=> "),
+    );
+    bar
+}
+
+fn run_experiment(args: RunArgs) -> Result<()> {
+    let path = experiment::find_experiment(&args.experiment)?;
+    let exp = Experiment::load(&path, args.quick)?;
+    if args.cells {
+        println!("# {}: {} cells (cell, estimator label, run)", exp.name, exp.cells().len());
+        for (k, (e, r)) in exp.cells().into_iter().enumerate() {
+            println!("{k}\t{}\t{r}", exp.estimators[e].label);
+        }
+        return Ok(());
+    }
+    let pool = thread_pool(args.threads)?;
+    let bar = experiment_bar();
+    let options = experiment::RunOptions {
+        results_root: args.results.clone(),
+        fresh: args.fresh,
+        cell: args.cell,
+    };
+    let outcome = pool.install(|| {
+        if args.prepare {
+            experiment::prepare(&exp, &options, &bar).map(|_| None)
+        } else {
+            experiment::run(&exp, &options, &bar)
+        }
+    });
+    bar.finish_and_clear();
+    match outcome? {
+        Some(summary) => print_summary(&summary, &args.results.join(&exp.name)),
+        None if args.prepare => eprintln!("{}: reference ready", exp.name),
+        None => eprintln!(
+            "{}: cell {} done; `mltbench report {}` merges the cells",
+            exp.name,
+            args.cell.unwrap_or(0),
+            args.experiment
+        ),
+    }
+    Ok(())
+}
+
+fn print_summary(summary: &experiment::Summary, dir: &Path) {
+    eprintln!("{}: results in {}", summary.experiment, dir.display());
+    for e in &summary.estimators {
+        eprintln!(
+            "  {:<16} relMSE {:.3e} [{:.3e}, {:.3e}] after {:.1} s, slope {}",
+            e.label,
+            e.relmse.mean,
+            e.relmse.lo,
+            e.relmse.hi,
+            e.seconds,
+            e.slope_seconds
+                .map(|f| format!("{:.2} ± {:.2}", f.slope, f.slope_se))
+                .unwrap_or_else(|| "–".into())
+        );
+    }
+    if !summary.missing_cells.is_empty() {
+        eprintln!("  missing: {}", summary.missing_cells.join(", "));
+    }
+}
+
+fn list_experiments() -> Result<()> {
+    for (name, description) in experiment::list_experiments()? {
+        println!("{name:<20} {description}");
+    }
+    Ok(())
+}
+
+fn report_experiment(args: ReportArgs) -> Result<()> {
+    let path = experiment::find_experiment(&args.experiment)?;
+    let exp = Experiment::load(&path, args.quick)?;
+    let bar = experiment_bar();
+    let summary = experiment::report_only(&exp, &args.results, &bar);
+    bar.finish_and_clear();
+    print_summary(&summary?, &args.results.join(&exp.name));
+    Ok(())
+}
+
+fn render_reference(args: ReferenceArgs) -> Result<()> {
+    Params::parse(&args.set)?; // rejects a malformed --set before any rendering
+    let budget = match (args.spp, args.time) {
+        (_, Some(t)) if t.is_finite() && t > 0.0 => Budget::Seconds(t),
+        (Some(n), None) if n >= 2 => Budget::Passes(n),
+        _ => {
+            return Err(Error::usage(
+                "give --spp N (N >= 2: two halves) or --time SECONDS (> 0)",
+            ));
+        }
+    };
+    let output = args.output.clone().unwrap_or_else(|| {
+        let stem = args.scene.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
+        PathBuf::from(format!("{stem}-reference.exr"))
+    });
+    let scene = Scene::build(mitsuba::load_file_with(&args.scene, &parse_defines(&args.define)?)?)?;
+    let pool = thread_pool(args.threads)?;
+    let bar = experiment_bar();
+    let rendered = pool.install(|| {
+        experiment::reference::render_reference(
+            &scene,
+            &args.estimator,
+            &args.set,
+            budget,
+            args.seed,
+            |half, pass| bar.set_message(format!("half {}/2, pass {pass}", half + 1)),
+        )
+    });
+    bar.finish_and_clear();
+    let (image, mut info) = rendered?;
+    info.scene = args.scene.display().to_string();
+    experiment::reference::save(&output, &image, &info)?;
+    eprintln!(
+        "reference: {} passes, {:.1} s, own noise relMSE ≈ {:.3e} -> {} (+ .json, .png)",
+        info.passes,
+        info.seconds,
+        info.noise_relmse.unwrap_or(f64::NAN),
+        output.display()
+    );
+    Ok(())
+}
+
+fn compare(args: CompareArgs) -> Result<()> {
+    let image = io::exr::read_exr(&args.image)?;
+    let reference = experiment::reference::load(&args.reference)?;
+    let m = experiment::metrics::metrics(&image, &reference.image)?;
+    println!("relmse {:.6e}", m.relmse);
+    println!("rmse   {:.6e}", m.rmse);
+    println!("mape   {:.6e}", m.mape);
+    if let Some(noise) = reference.info.noise_relmse {
+        println!("reference noise relmse {noise:.6e}");
+        if m.relmse < noise {
+            println!("note: the error is below the reference's own noise: not meaningful");
+        }
+    }
     Ok(())
 }
 

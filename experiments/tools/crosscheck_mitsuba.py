@@ -42,7 +42,7 @@ MAX_LANES = 1 << 24
 # Suffix of `mltbench render`'s last report line (src/main.rs).
 MLTBENCH_LINE = re.compile(
     r"^(?P<est>\S+): (?P<passes>\d+) passes, (?P<samples>\d+) samples, (?P<secs>[0-9.]+) s "
-    r"\((?P<msps>[0-9.]+) M samples/s"
+    r"\((?P<msps>[0-9.]+) M samples/s[^)]*\)(, (?P<dropped>\d+) invalid samples dropped)?"
 )
 
 
@@ -68,8 +68,11 @@ def worker(job_file):
     # Scenes that declare `<default name="spp">` take the sample count as a parameter;
     # passing a parameter the scene does not use is an error in Mitsuba.
     declares_spp = re.search(r"\$spp\b", Path(scene_path).read_text()) is not None
+    params = dict(job["defines"])
+    if declares_spp:
+        params["spp"] = str(max(spps))
     t0 = time.perf_counter()
-    scene = mi.load_file(scene_path, spp=max(spps)) if declares_spp else mi.load_file(scene_path)
+    scene = mi.load_file(scene_path, **params)
     load_seconds = time.perf_counter() - t0
     film = scene.sensors()[0].film()
     width, height = (int(v) for v in film.crop_size())
@@ -130,6 +133,7 @@ def run_mitsuba(args, variant, spps, outdir):
         "threads": args.threads,
         "seed": args.seed,
         "spps": spps,
+        "defines": args.defines,
         "outdir": str(outdir),
         "result": str(outdir / f"mitsuba-{variant}.json"),
     }
@@ -168,7 +172,7 @@ def run_mitsuba(args, variant, spps, outdir):
 
 
 def run_mltbench(args, spp, outdir):
-    """Run `mltbench render`; returns (exr path, samples, seconds, M samples/s)."""
+    """Run `mltbench render`; returns (exr path, samples, seconds, M samples/s, dropped)."""
     exr = outdir / f"mltbench-{args.estimator}-spp{spp}.exr"
     cmd = [
         str(args.mltbench),
@@ -185,6 +189,8 @@ def run_mltbench(args, spp, outdir):
         "-o",
         str(exr),
     ]
+    for name, value in args.defines:
+        cmd += ["-D", f"{name}={value}"]
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True)
     except OSError as e:
@@ -211,7 +217,8 @@ def run_mltbench(args, spp, outdir):
     msps = float(found["msps"])
     if msps <= 0:
         msps = samples / max(float(found["secs"]), 1e-9) / 1e6
-    return exr, samples, float(found["secs"]), msps
+    dropped = int(found["dropped"]) if found["dropped"] is not None else None
+    return exr, samples, float(found["secs"]), msps, dropped
 
 
 def read_rgb(path):
@@ -293,7 +300,7 @@ def print_block(variant, spp, cmp, mits, mrun, mlt, threads):
     width, height = mits["width"], mits["height"]
     paths = width * height * spp
     mits_mps = paths / mrun["seconds"] / 1e6
-    _, mlt_samples, mlt_secs, mlt_mps = mlt
+    _, mlt_samples, mlt_secs, mlt_mps, dropped = mlt
     print(f"\n== spp {spp}: mltbench vs Mitsuba {variant} ==")
     print(f"{'':22}{'R':>12}{'G':>12}{'B':>12}")
     print(f"{'mean mltbench':22}" + "".join(f"{v:12.6g}" for v in cmp["mean_x"]))
@@ -307,6 +314,8 @@ def print_block(variant, spp, cmp, mits, mrun, mlt, threads):
     if any(cmp["nonfinite"]):
         print(f"  warning: non-finite values: {cmp['nonfinite'][0]} in mltbench, "
               f"{cmp['nonfinite'][1]} in Mitsuba")
+    if dropped:
+        print(f"  warning: mltbench dropped {dropped} invalid (NaN, infinite or negative) samples")
     print(
         f"throughput mltbench   {mlt_mps:.3f} M paths/s ({mlt_mps / threads:.3f} per thread; "
         f"{mlt_samples} paths in {mlt_secs:.2f} s)"
@@ -322,7 +331,7 @@ def print_block(variant, spp, cmp, mits, mrun, mlt, threads):
 
 
 CSV_FIELDS = [
-    "scene", "estimator", "variant", "spp", "threads", "seed", "width", "height",
+    "scene", "defines", "estimator", "variant", "spp", "threads", "seed", "width", "height",
     "mean_ratio_r", "mean_ratio_g", "mean_ratio_b",
     "sigma_r", "sigma_g", "sigma_b",
     "sigma_paired_r", "sigma_paired_g", "sigma_paired_b",
@@ -373,6 +382,15 @@ def parse_args(argv):
     )
     p.add_argument("--threads", type=int, default=2, help="threads for both renderers (default 2)")
     p.add_argument("--seed", type=int, default=0, help="seed for both renderers (default 0)")
+    p.add_argument(
+        "-D",
+        "--define",
+        action="append",
+        default=[],
+        metavar="NAME=VALUE",
+        help="scene parameter (a <default name=...>) for both renderers, repeatable: "
+        "-D res=128 -D max_depth=3",
+    )
     p.add_argument("--keep", type=Path, metavar="DIR", help="keep the EXR images in DIR")
     p.add_argument("--csv", type=Path, metavar="FILE", help="append one row per comparison")
     # Debug: test the plumbing with another mltbench estimator (e.g. eyelight).
@@ -387,6 +405,15 @@ def parse_args(argv):
         args.spps = [args.spp]
     if not args.spps or min(args.spps) < 1:
         p.error("spp must be at least 1")
+    args.defines = []
+    for d in args.define:
+        name, eq, value = d.partition("=")
+        name = name.strip()
+        if not eq or not name:
+            p.error(f"-D expects NAME=VALUE, got {d!r}")
+        if name == "spp":
+            p.error("set the sample count with --spp or --spp-list, not -D spp=")
+        args.defines.append((name, value.strip()))
     if args.threads < 1:
         p.error("--threads must be at least 1")
     if not 0 <= args.seed < 1 << 32:
@@ -463,6 +490,8 @@ def crosscheck(args, outdir):
           f"{any_m['rfilter']}; spp {'passed as $spp' if any_m['declares_spp'] else 'set on render'})")
     print(f"mltbench  {args.mltbench} --estimator {args.estimator}, "
           f"{args.threads} threads, seed {args.seed}")
+    if args.defines:
+        print("defines   " + " ".join(f"{n}={v}" for n, v in args.defines) + " (both renderers)")
     for v, m in results.items():
         line = (f"mitsuba   {m['mitsuba']} (drjit {m['drjit']}) {v}, {m['threads']} threads; "
                 f"scene load {m['load_seconds']:.2f} s, not timed")
@@ -488,7 +517,9 @@ def crosscheck(args, outdir):
             tables.setdefault(v, []).append((spp, cmp["relmse"]))
             if args.csv:
                 row = {
-                    "scene": str(args.scene), "estimator": args.estimator, "variant": v,
+                    "scene": str(args.scene),
+                    "defines": ";".join(f"{n}={v}" for n, v in args.defines),
+                    "estimator": args.estimator, "variant": v,
                     "spp": spp, "threads": args.threads, "seed": args.seed,
                     "width": m["width"], "height": m["height"],
                     "relmse": f"{cmp['relmse']:.6g}",

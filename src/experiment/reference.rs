@@ -1,0 +1,195 @@
+//! References: the long renders every error is measured against, with their own noise.
+//!
+//! A rendered reference is two independent halves (different seeds, half the budget each),
+//! averaged. Their difference estimates the reference's own error (`metrics::
+//! reference_noise`): an estimator's error below it cannot be told apart from the
+//! reference's, and reports flag it. References are cached under `results/references/`,
+//! keyed by a hash of every scene file read, the scene parameters, the estimator, its
+//! parameters, the budget, the seed and the mltbench version: change any of them and a new
+//! reference is rendered.
+
+use std::path::{Path, PathBuf};
+
+use serde::{Deserialize, Serialize};
+
+use super::metrics::reference_noise;
+use crate::error::{Error, Location, Result};
+use crate::estimator::{self, Params};
+use crate::image::Image;
+use crate::io::atomic::write_file_atomically;
+use crate::io::exr::{read_exr, write_exr};
+use crate::io::png::write_png_preview;
+use crate::render::{Budget, render};
+use crate::sampler::independent::hash_words;
+use crate::scene::Scene;
+
+/// What is stored beside a reference EXR (`NAME.json`).
+#[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+pub struct ReferenceInfo {
+    /// The cache key (hex) the reference was rendered for; empty for a file given by hand.
+    pub key: String,
+    pub scene: String,
+    pub estimator: String,
+    pub params: Vec<String>,
+    pub passes: u64,
+    pub samples: u64,
+    pub seconds: f64,
+    pub seed: u64,
+    /// The reference's own relMSE, estimated from its two halves (`None`: unknown).
+    pub noise_relmse: Option<f64>,
+}
+
+/// A reference image and what is known about it.
+#[derive(Clone, Debug)]
+pub struct Reference {
+    pub image: Image,
+    pub info: ReferenceInfo,
+    pub path: PathBuf,
+}
+
+/// How the two halves are seeded: far from any run's seed.
+const HALF_SEED_TAG: u64 = 0x5EF0_5EF0;
+
+/// Renders `scene` with `estimator` as two independent halves of `budget` and averages them
+/// (weighted by their samples). `on_pass(half, passes done)` reports progress.
+pub fn render_reference(
+    scene: &Scene,
+    estimator_name: &str,
+    params: &[String],
+    budget: Budget,
+    seed: u64,
+    mut on_pass: impl FnMut(usize, u32),
+) -> Result<(Image, ReferenceInfo)> {
+    let half_budget = match budget {
+        Budget::Passes(p) => Budget::Passes(p.div_ceil(2)),
+        Budget::Seconds(s) => Budget::Seconds(s / 2.0),
+    };
+    let mut halves = Vec::new();
+    let (mut passes, mut samples, mut seconds) = (0u64, 0u64, 0f64);
+    for half in 0..2 {
+        let params = Params::parse(params)?;
+        let half_seed = hash_words(&[seed, HALF_SEED_TAG, half as u64]);
+        let mut est = estimator::create(estimator_name, &params, scene, half_seed)?;
+        let out = render(scene, est.as_mut(), half_budget, |p, _| on_pass(half, p));
+        passes += out.stats.passes;
+        samples += out.stats.samples;
+        seconds += out.seconds;
+        halves.push((out.image, out.stats.samples.max(1) as f64));
+    }
+    let (a, wa) = &halves[0];
+    let (b, wb) = &halves[1];
+    let mut image = Image::new(a.width, a.height);
+    for (i, p) in image.pixels.iter_mut().enumerate() {
+        *p = (a.pixels[i] * (*wa as f32) + b.pixels[i] * (*wb as f32)) / ((wa + wb) as f32);
+    }
+    let noise = reference_noise(a, b)?;
+    Ok((
+        image,
+        ReferenceInfo {
+            key: String::new(),
+            scene: String::new(),
+            estimator: estimator_name.to_string(),
+            params: params.to_vec(),
+            passes,
+            samples,
+            seconds,
+            seed,
+            noise_relmse: Some(noise),
+        },
+    ))
+}
+
+/// The cache key of a rendered reference (see the module docs).
+pub fn cache_key(
+    scene: &Scene,
+    scene_params: &[(String, String)],
+    estimator_name: &str,
+    params: &[String],
+    budget: Budget,
+    seed: u64,
+) -> Result<String> {
+    let mut words: Vec<u64> = vec![seed];
+    let mut add_bytes = |bytes: &[u8]| {
+        words.push(bytes.len() as u64);
+        for chunk in bytes.chunks(8) {
+            let mut w = [0u8; 8];
+            w[..chunk.len()].copy_from_slice(chunk);
+            words.push(u64::from_le_bytes(w));
+        }
+    };
+    let mut files = scene.description.files_read.clone();
+    files.sort();
+    files.dedup();
+    for f in &files {
+        let bytes = std::fs::read(f).map_err(|e| Error::io(f, e))?;
+        add_bytes(&bytes);
+    }
+    for (k, v) in scene_params {
+        add_bytes(format!("{k}={v}").as_bytes());
+    }
+    add_bytes(estimator_name.as_bytes());
+    for p in params {
+        add_bytes(p.as_bytes());
+    }
+    add_bytes(format!("{budget:?}").as_bytes());
+    add_bytes(env!("CARGO_PKG_VERSION").as_bytes());
+    Ok(format!("{:016x}", hash_words(&words)))
+}
+
+/// Writes a reference EXR, its PNG preview and its `.json` information, atomically.
+pub fn save(path: &Path, image: &Image, info: &ReferenceInfo) -> Result<()> {
+    if let Some(dir) = path.parent() {
+        std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+    }
+    write_exr(path, image)?;
+    write_png_preview(&path.with_extension("png"), image)?;
+    let json = serde_json::to_string_pretty(info).expect("reference info serialises");
+    write_file_atomically(&path.with_extension("json"), json.as_bytes())
+}
+
+/// Reads a reference EXR and, if present, the `.json` beside it.
+pub fn load(path: &Path) -> Result<Reference> {
+    let image = read_exr(path)?;
+    if let Some((i, _)) = image
+        .pixels
+        .iter()
+        .enumerate()
+        .find(|(_, p)| !p.is_valid_radiance())
+    {
+        return Err(Error::input(
+            Location::file(path),
+            format!(
+                "reference pixel ({}, {}) is not a finite, non-negative radiance",
+                i as u32 % image.width,
+                i as u32 / image.width
+            ),
+        ));
+    }
+    let json_path = path.with_extension("json");
+    let info = if json_path.exists() {
+        let text = std::fs::read_to_string(&json_path).map_err(|e| Error::io(&json_path, e))?;
+        serde_json::from_str(&text).map_err(|e| {
+            Error::input(
+                Location::file(&json_path),
+                format!("not a reference description: {e}"),
+            )
+        })?
+    } else {
+        ReferenceInfo {
+            key: String::new(),
+            scene: String::new(),
+            estimator: "(given)".into(),
+            params: Vec::new(),
+            passes: 0,
+            samples: 0,
+            seconds: 0.0,
+            seed: 0,
+            noise_relmse: None,
+        }
+    };
+    Ok(Reference {
+        image,
+        info,
+        path: path.to_path_buf(),
+    })
+}

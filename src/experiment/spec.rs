@@ -1,0 +1,393 @@
+//! `experiments/NAME.toml`: what an experiment compares, for how long, against what.
+//!
+//! ```toml
+//! description = "Cornell box: the estimators agree on a diffuse scene"
+//! scene = "scenes/cbox.xml"          # relative to this file
+//! scene_params = { res = 128 }       # the scene's <default> parameters (Mitsuba's -D)
+//! budget = { seconds = 20 }          # per run: equal time; or { passes = 256 }: equal work
+//! checkpoints = 8                    # log-spaced, each doubling the budget before it
+//! runs = 4                           # independent runs (seeds) per estimator
+//! seed = 1                           # base seed; every run's seed derives from it
+//!
+//! [reference]                        # a file, or an estimator and a budget to render one
+//! estimator = "pt"
+//! budget = { passes = 4096 }
+//!
+//! [[estimator]]                      # the same estimator may appear twice, with labels
+//! name = "pt"
+//! label = "pt (rr 5)"
+//! params = { rr_depth = 5 }
+//!
+//! [[region]]                         # optional crops, measured and shown zoomed
+//! label = "caustic"
+//! x = 40
+//! y = 90
+//! width = 32
+//! height = 24
+//!
+//! [quick]                            # what --quick does (defaults shown)
+//! scale = 0.1                        # budgets (experiment and reference) × scale
+//! runs = 2                           # at most this many runs
+//! ```
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use serde::Deserialize;
+
+use crate::error::{Error, Location, Result};
+use crate::estimator::ESTIMATOR_NAMES;
+use crate::render::Budget;
+
+/// The experiment as written in its TOML file.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SpecFile {
+    description: String,
+    scene: PathBuf,
+    #[serde(default)]
+    scene_params: BTreeMap<String, toml::Value>,
+    budget: BudgetFile,
+    checkpoints: u32,
+    runs: u32,
+    #[serde(default)]
+    seed: u64,
+    reference: ReferenceFile,
+    #[serde(rename = "estimator")]
+    estimators: Vec<EstimatorFile>,
+    #[serde(default, rename = "region")]
+    regions: Vec<Region>,
+    #[serde(default)]
+    quick: QuickFile,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct BudgetFile {
+    seconds: Option<f64>,
+    passes: Option<u32>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ReferenceFile {
+    file: Option<PathBuf>,
+    estimator: Option<String>,
+    budget: Option<BudgetFile>,
+    #[serde(default)]
+    params: BTreeMap<String, toml::Value>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct EstimatorFile {
+    name: String,
+    label: Option<String>,
+    #[serde(default)]
+    params: BTreeMap<String, toml::Value>,
+}
+
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct QuickFile {
+    #[serde(default = "default_quick_scale")]
+    scale: f64,
+    #[serde(default = "default_quick_runs")]
+    runs: u32,
+}
+
+fn default_quick_scale() -> f64 {
+    0.1
+}
+
+fn default_quick_runs() -> u32 {
+    2
+}
+
+impl Default for QuickFile {
+    fn default() -> Self {
+        QuickFile {
+            scale: default_quick_scale(),
+            runs: default_quick_runs(),
+        }
+    }
+}
+
+/// A rectangle of pixels measured on its own (e.g. a caustic).
+#[derive(Clone, Debug, Deserialize, serde::Serialize, PartialEq, Eq)]
+#[serde(deny_unknown_fields)]
+pub struct Region {
+    pub label: String,
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+/// One competitor: an estimator with its parameters under a unique label.
+#[derive(Clone, Debug, PartialEq)]
+pub struct EstimatorEntry {
+    pub name: String,
+    pub label: String,
+    /// `key=value` strings, as `--set` takes them.
+    pub params: Vec<String>,
+}
+
+/// Where the reference comes from.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ReferenceSource {
+    File(PathBuf),
+    Render {
+        estimator: String,
+        params: Vec<String>,
+        budget: Budget,
+    },
+}
+
+/// A validated experiment.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Experiment {
+    /// The file stem (`cbox` for `experiments/cbox.toml`), or with `-quick` under --quick.
+    pub name: String,
+    pub spec_path: PathBuf,
+    pub description: String,
+    pub scene: PathBuf,
+    /// `<default>` parameters of the scene, as (name, value).
+    pub scene_params: Vec<(String, String)>,
+    pub budget: Budget,
+    pub checkpoints: u32,
+    pub runs: u32,
+    pub seed: u64,
+    pub reference: ReferenceSource,
+    pub estimators: Vec<EstimatorEntry>,
+    pub regions: Vec<Region>,
+}
+
+/// The largest number of checkpoints (each doubles the previous budget).
+pub const MAX_CHECKPOINTS: u32 = 24;
+
+impl Experiment {
+    /// Reads and checks `path`. With `quick`, budgets shrink and runs are capped as its
+    /// `[quick]` table says, and the name gets a `-quick` suffix (separate results).
+    pub fn load(path: &Path, quick: bool) -> Result<Experiment> {
+        let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+        Experiment::parse(&text, path, quick)
+    }
+
+    pub fn parse(text: &str, path: &Path, quick: bool) -> Result<Experiment> {
+        let fail = |message: String| Error::input(Location::file(path), message);
+        let file: SpecFile = toml::from_str(text).map_err(|e| fail(e.to_string()))?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        let stem = path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .ok_or_else(|| fail("the experiment file needs a UTF-8 name".into()))?;
+
+        if file.runs == 0 {
+            return Err(fail("runs must be at least 1".into()));
+        }
+        if file.checkpoints == 0 || file.checkpoints > MAX_CHECKPOINTS {
+            return Err(fail(format!(
+                "checkpoints must be between 1 and {MAX_CHECKPOINTS}, got {}",
+                file.checkpoints
+            )));
+        }
+        if !(file.quick.scale > 0.0 && file.quick.scale <= 1.0) || file.quick.runs == 0 {
+            return Err(fail(
+                "[quick] needs 0 < scale <= 1 and runs >= 1".to_string(),
+            ));
+        }
+        let scale = if quick { file.quick.scale } else { 1.0 };
+        let budget = budget(&file.budget, "budget", scale).map_err(fail)?;
+        let runs = if quick {
+            file.runs.min(file.quick.runs)
+        } else {
+            file.runs
+        };
+
+        if file.estimators.is_empty() {
+            return Err(fail("no [[estimator]]: nothing to compare".into()));
+        }
+        let mut estimators: Vec<EstimatorEntry> = Vec::new();
+        for e in &file.estimators {
+            check_estimator_name(&e.name).map_err(fail)?;
+            let label = e.label.clone().unwrap_or_else(|| e.name.clone());
+            if !is_safe_label(&label) {
+                return Err(fail(format!(
+                    "estimator label \"{label}\": use letters, digits, spaces and . _ - ( ) only"
+                )));
+            }
+            if estimators
+                .iter()
+                .any(|o| file_label(&o.label) == file_label(&label))
+            {
+                return Err(fail(format!(
+                    "two estimators are labelled \"{label}\" (or alike once spaces and \
+                     brackets become _): give each a distinct label"
+                )));
+            }
+            estimators.push(EstimatorEntry {
+                name: e.name.clone(),
+                label,
+                params: params_to_strings(&e.params).map_err(fail)?,
+            });
+        }
+
+        let reference = match (&file.reference.file, &file.reference.estimator) {
+            (Some(f), None) => {
+                if file.reference.budget.is_some() || !file.reference.params.is_empty() {
+                    return Err(fail(
+                        "[reference] with a file takes no budget or params".into(),
+                    ));
+                }
+                ReferenceSource::File(dir.join(f))
+            }
+            (None, Some(estimator)) => {
+                check_estimator_name(estimator).map_err(fail)?;
+                let b = file.reference.budget.ok_or_else(|| {
+                    fail("[reference] with an estimator needs a budget".into())
+                })?;
+                ReferenceSource::Render {
+                    estimator: estimator.clone(),
+                    params: params_to_strings(&file.reference.params).map_err(fail)?,
+                    budget: budget(&b, "reference.budget", scale).map_err(fail)?,
+                }
+            }
+            _ => {
+                return Err(fail(
+                    "[reference] needs either file = \"...\" or estimator = \"...\" with a budget"
+                        .into(),
+                ));
+            }
+        };
+
+        let mut regions: Vec<Region> = Vec::new();
+        for r in &file.regions {
+            if r.width == 0 || r.height == 0 {
+                return Err(fail(format!("region \"{}\" is empty", r.label)));
+            }
+            if !is_safe_label(&r.label) || regions.iter().any(|o| o.label == r.label) {
+                return Err(fail(format!(
+                    "region label \"{}\" must be unique and use letters, digits, spaces and . _ - ( )",
+                    r.label
+                )));
+            }
+            regions.push(r.clone());
+        }
+
+        let scene_params = file
+            .scene_params
+            .iter()
+            .map(|(k, v)| Ok((k.clone(), value_to_string(k, v)?)))
+            .collect::<std::result::Result<Vec<_>, String>>()
+            .map_err(fail)?;
+
+        Ok(Experiment {
+            name: if quick {
+                format!("{stem}-quick")
+            } else {
+                stem.to_string()
+            },
+            spec_path: path.to_path_buf(),
+            description: file.description.trim().to_string(),
+            scene: dir.join(&file.scene),
+            scene_params,
+            budget,
+            checkpoints: file.checkpoints,
+            runs,
+            seed: file.seed,
+            reference,
+            estimators,
+            regions,
+        })
+    }
+
+    /// The independent cells (estimator index, run), in a fixed order: `--cell K` runs
+    /// number K of this list.
+    pub fn cells(&self) -> Vec<(usize, u32)> {
+        (0..self.estimators.len())
+            .flat_map(|e| (0..self.runs).map(move |r| (e, r)))
+            .collect()
+    }
+
+    /// The budget spent by the end of checkpoint `k` (0-based): log-spaced, each checkpoint
+    /// doubling the one before, the last at the full budget. Pass counts are rounded up
+    /// and never repeat.
+    pub fn checkpoint_budgets(&self) -> Vec<Budget> {
+        let n = self.checkpoints as i32;
+        match self.budget {
+            Budget::Seconds(s) => (0..n)
+                .map(|k| Budget::Seconds(s * 2f64.powi(k - n + 1)))
+                .collect(),
+            Budget::Passes(p) => {
+                let mut out: Vec<u32> = Vec::new();
+                for k in 0..n {
+                    let passes = ((p as f64) * 2f64.powi(k - n + 1)).ceil().max(1.0) as u32;
+                    if out.last() != Some(&passes) {
+                        out.push(passes);
+                    }
+                }
+                out.into_iter().map(Budget::Passes).collect()
+            }
+        }
+    }
+}
+
+fn budget(b: &BudgetFile, what: &str, scale: f64) -> std::result::Result<Budget, String> {
+    match (b.seconds, b.passes) {
+        (Some(s), None) if s.is_finite() && s > 0.0 => Ok(Budget::Seconds(s * scale)),
+        (None, Some(p)) if p > 0 => Ok(Budget::Passes(((p as f64 * scale).ceil() as u32).max(1))),
+        _ => Err(format!(
+            "{what} must be {{ seconds = S }} (S > 0) or {{ passes = N }} (N >= 1), not both"
+        )),
+    }
+}
+
+fn check_estimator_name(name: &str) -> std::result::Result<(), String> {
+    if ESTIMATOR_NAMES.contains(&name) {
+        Ok(())
+    } else {
+        Err(format!(
+            "unknown estimator \"{name}\" (known: {})",
+            ESTIMATOR_NAMES.join(", ")
+        ))
+    }
+}
+
+/// Labels become file names: keep them to a safe alphabet.
+fn is_safe_label(label: &str) -> bool {
+    !label.is_empty()
+        && label.len() <= 64
+        && label
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || " ._-()".contains(c))
+}
+
+fn params_to_strings(
+    params: &BTreeMap<String, toml::Value>,
+) -> std::result::Result<Vec<String>, String> {
+    params
+        .iter()
+        .map(|(k, v)| Ok(format!("{k}={}", value_to_string(k, v)?)))
+        .collect()
+}
+
+fn value_to_string(key: &str, v: &toml::Value) -> std::result::Result<String, String> {
+    match v {
+        toml::Value::String(s) => Ok(s.clone()),
+        toml::Value::Integer(i) => Ok(i.to_string()),
+        toml::Value::Float(f) => Ok(f.to_string()),
+        toml::Value::Boolean(b) => Ok(b.to_string()),
+        _ => Err(format!(
+            "parameter \"{key}\" must be a string, number or boolean"
+        )),
+    }
+}
+
+/// A file-name-safe form of a label: spaces and brackets become `_`.
+pub fn file_label(label: &str) -> String {
+    label
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() || c == '.' || c == '-' { c } else { '_' })
+        .collect()
+}
