@@ -6,12 +6,12 @@
 pub mod camera;
 pub mod error;
 pub mod estimator;
+pub mod experiment;
 pub mod film;
 pub mod geometry;
 pub mod image;
 pub mod io;
 pub mod light;
-pub mod experiment;
 pub mod material;
 pub mod math;
 pub mod path;
