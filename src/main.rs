@@ -92,7 +92,12 @@ struct ReferenceArgs {
     #[arg(short, long, value_name = "NAME", help = estimator_help())]
     estimator: String,
     /// Passes in all (each half renders half of them).
-    #[arg(long, value_name = "N", conflicts_with = "time", required_unless_present = "time")]
+    #[arg(
+        long,
+        value_name = "N",
+        conflicts_with = "time",
+        required_unless_present = "time"
+    )]
     spp: Option<u32>,
     /// Seconds in all (each half renders half of them).
     #[arg(long, value_name = "SECONDS")]
@@ -278,7 +283,11 @@ fn run_experiment(args: RunArgs) -> Result<()> {
     let path = experiment::find_experiment(&args.experiment)?;
     let exp = Experiment::load(&path, args.quick)?;
     if args.cells {
-        println!("# {}: {} cells (cell, estimator label, run)", exp.name, exp.cells().len());
+        println!(
+            "# {}: {} cells (cell, estimator label, run)",
+            exp.name,
+            exp.cells().len()
+        );
         for (k, (e, r)) in exp.cells().into_iter().enumerate() {
             println!("{k}\t{}\t{r}", exp.estimators[e].label);
         }
@@ -290,6 +299,7 @@ fn run_experiment(args: RunArgs) -> Result<()> {
         results_root: args.results.clone(),
         fresh: args.fresh,
         cell: args.cell,
+        stop_after_checkpoints: None,
     };
     let outcome = pool.install(|| {
         if args.prepare {
@@ -361,10 +371,17 @@ fn render_reference(args: ReferenceArgs) -> Result<()> {
         }
     };
     let output = args.output.clone().unwrap_or_else(|| {
-        let stem = args.scene.file_stem().and_then(|s| s.to_str()).unwrap_or("scene");
+        let stem = args
+            .scene
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("scene");
         PathBuf::from(format!("{stem}-reference.exr"))
     });
-    let scene = Scene::build(mitsuba::load_file_with(&args.scene, &parse_defines(&args.define)?)?)?;
+    let scene = Scene::build(mitsuba::load_file_with(
+        &args.scene,
+        &parse_defines(&args.define)?,
+    )?)?;
     let pool = thread_pool(args.threads)?;
     let bar = experiment_bar();
     let rendered = pool.install(|| {

@@ -75,7 +75,11 @@ pub fn list_experiments() -> Result<Vec<(String, String)>> {
         if path.extension().and_then(|e| e.to_str()) != Some("toml") {
             continue;
         }
-        let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("").to_string();
+        let name = path
+            .file_stem()
+            .and_then(|s| s.to_str())
+            .unwrap_or("")
+            .to_string();
         let description = match Experiment::load(&path, false) {
             Ok(e) => e.description.lines().next().unwrap_or("").to_string(),
             Err(err) => format!("(cannot be read: {err})"),
@@ -95,11 +99,18 @@ pub struct RunOptions {
     pub fresh: bool,
     /// Run only this cell (`Experiment::cells` index) and write only its files.
     pub cell: Option<usize>,
+    /// Stop with an error after this many checkpoints (all cells together), as a kill
+    /// between checkpoints would: lets tests interrupt a run at a known point.
+    pub stop_after_checkpoints: Option<usize>,
 }
 
 /// Runs the experiment's cells that are not complete yet (or only `options.cell`), then,
 /// unless a single cell was asked for, writes the report. Returns the summary if reported.
-pub fn run(experiment: &Experiment, options: &RunOptions, bar: &ProgressBar) -> Result<Option<Summary>> {
+pub fn run(
+    experiment: &Experiment,
+    options: &RunOptions,
+    bar: &ProgressBar,
+) -> Result<Option<Summary>> {
     let results = ResultsDir::new(&options.results_root, experiment);
     let cells = experiment.cells();
     let selected: Vec<(usize, u32)> = match options.cell {
@@ -123,7 +134,12 @@ pub fn run(experiment: &Experiment, options: &RunOptions, bar: &ProgressBar) -> 
 
     let todo: Vec<(usize, u32)> = selected
         .into_iter()
-        .map(|(e, r)| Ok(((e, r), runner::cell_is_complete(experiment, &results, e, r)?)))
+        .map(|(e, r)| {
+            Ok((
+                (e, r),
+                runner::cell_is_complete(experiment, &results, e, r)?,
+            ))
+        })
         .collect::<Result<Vec<_>>>()?
         .into_iter()
         .filter(|(_, done)| !done)
@@ -135,8 +151,27 @@ pub fn run(experiment: &Experiment, options: &RunOptions, bar: &ProgressBar) -> 
     };
     bar.set_length(per_cell * todo.len() as u64);
     bar.set_position(0);
+    let mut checkpoints_done = 0usize;
+    let mut after_checkpoint = || {
+        checkpoints_done += 1;
+        match options.stop_after_checkpoints {
+            Some(n) if checkpoints_done >= n => Err(Error::usage(format!(
+                "{}: interrupted after {n} checkpoints, as asked",
+                experiment.name
+            ))),
+            _ => Ok(()),
+        }
+    };
     for (e, r) in todo {
-        runner::run_cell(experiment, &scene, &reference, &results, e, r, bar)?;
+        runner::run_cell(
+            experiment,
+            &scene,
+            &reference,
+            &results,
+            (e, r),
+            bar,
+            &mut after_checkpoint,
+        )?;
     }
     if options.cell.is_some() {
         return Ok(None);
@@ -146,7 +181,11 @@ pub fn run(experiment: &Experiment, options: &RunOptions, bar: &ProgressBar) -> 
 }
 
 /// Merges the cells present under `results/NAME/` into the summary, plots and README.
-pub fn report_only(experiment: &Experiment, results_root: &Path, bar: &ProgressBar) -> Result<Summary> {
+pub fn report_only(
+    experiment: &Experiment,
+    results_root: &Path,
+    bar: &ProgressBar,
+) -> Result<Summary> {
     let results = ResultsDir::new(results_root, experiment);
     let scene = runner::load_scene(experiment)?;
     runner::check_fingerprint(&results, &runner::fingerprint(experiment, &scene)?)?;

@@ -8,11 +8,15 @@ use std::path::Path;
 use serde::Serialize;
 
 use super::metrics::relative_error_map;
-use super::plot::{Band, Crop, Series, SheetEntry, bias_variance_plot, contact_sheet, convergence_plot};
+use super::plot::{
+    Band, Crop, Series, SheetEntry, bias_variance_plot, contact_sheet, convergence_plot,
+};
 use super::reference::Reference;
 use super::runner::{ResultsDir, Row, cell_is_complete, read_rows, write_rows};
 use super::spec::Experiment;
-use super::statistics::{BiasVariance, Interval, SlopeFit, bias_variance, fit_later_half, mean_interval};
+use super::statistics::{
+    BiasVariance, Interval, SlopeFit, bias_variance, fit_later_half, mean_interval,
+};
 use crate::error::{Error, Result};
 use crate::image::Image;
 use crate::io::atomic::write_file_atomically;
@@ -67,7 +71,11 @@ pub struct Summary {
 
 /// Reads every complete cell, writes `metrics.csv`, `regions.csv`, `summary.csv`,
 /// `summary.json`, the plots and `README.md`. Fails if no cell is complete.
-pub fn report(experiment: &Experiment, results: &ResultsDir, reference: &Reference) -> Result<Summary> {
+pub fn report(
+    experiment: &Experiment,
+    results: &ResultsDir,
+    reference: &Reference,
+) -> Result<Summary> {
     let mut rows: Vec<Row> = Vec::new();
     let mut missing = Vec::new();
     for (e, r) in experiment.cells() {
@@ -85,10 +93,18 @@ pub fn report(experiment: &Experiment, results: &ResultsDir, reference: &Referen
             results.dir.display()
         )));
     }
-    let whole: Vec<Row> = rows.iter().filter(|r| r.region.is_empty()).cloned().collect();
+    let whole: Vec<Row> = rows
+        .iter()
+        .filter(|r| r.region.is_empty())
+        .cloned()
+        .collect();
     write_metrics_csv(&results.dir.join("metrics.csv"), &whole)?;
     if !experiment.regions.is_empty() {
-        let regions: Vec<Row> = rows.iter().filter(|r| !r.region.is_empty()).cloned().collect();
+        let regions: Vec<Row> = rows
+            .iter()
+            .filter(|r| !r.region.is_empty())
+            .cloned()
+            .collect();
         write_rows(&results.dir.join("regions.csv"), &regions)?;
     }
 
@@ -101,7 +117,10 @@ pub fn report(experiment: &Experiment, results: &ResultsDir, reference: &Referen
     let mut variance_series = Vec::new();
     let mut sheet = Vec::new();
     for entry in &experiment.estimators {
-        let mine: Vec<&Row> = whole.iter().filter(|r| r.estimator == entry.label).collect();
+        let mine: Vec<&Row> = whole
+            .iter()
+            .filter(|r| r.estimator == entry.label)
+            .collect();
         if mine.is_empty() {
             continue;
         }
@@ -111,16 +130,37 @@ pub fn report(experiment: &Experiment, results: &ResultsDir, reference: &Referen
             v.dedup();
             v
         };
-        let at = |k: u32| -> Vec<&Row> { mine.iter().copied().filter(|r| r.checkpoint == k).collect() };
+        let at =
+            |k: u32| -> Vec<&Row> { mine.iter().copied().filter(|r| r.checkpoint == k).collect() };
         let finals = at(last);
         let values = |f: fn(&Row) -> f64| -> Vec<f64> { finals.iter().map(|r| f(r)).collect() };
         let relmse = mean_interval(&values(|r| r.relmse), CONFIDENCE);
 
         // Convergence curves: run mean and run range at each checkpoint.
-        let mut band_s = Band { x: vec![], mean: vec![], lo: vec![], hi: vec![] };
-        let mut band_p = Band { x: vec![], mean: vec![], lo: vec![], hi: vec![] };
-        let mut bias_band = Band { x: vec![], mean: vec![], lo: vec![], hi: vec![] };
-        let mut var_band = Band { x: vec![], mean: vec![], lo: vec![], hi: vec![] };
+        let mut band_s = Band {
+            x: vec![],
+            mean: vec![],
+            lo: vec![],
+            hi: vec![],
+        };
+        let mut band_p = Band {
+            x: vec![],
+            mean: vec![],
+            lo: vec![],
+            hi: vec![],
+        };
+        let mut bias_band = Band {
+            x: vec![],
+            mean: vec![],
+            lo: vec![],
+            hi: vec![],
+        };
+        let mut var_band = Band {
+            x: vec![],
+            mean: vec![],
+            lo: vec![],
+            hi: vec![],
+        };
         for k in 0..=last {
             let rows_k = at(k);
             if rows_k.is_empty() {
@@ -145,7 +185,10 @@ pub fn report(experiment: &Experiment, results: &ResultsDir, reference: &Referen
                     .map(|&r| read_exr(&results.checkpoint_image(&entry.label, r, k)))
                     .collect::<Result<Vec<Image>>>()?;
                 let bv = bias_variance(&images, &reference.image)?;
-                for (band, i) in [(&mut bias_band, bv.relative_bias2), (&mut var_band, bv.relative_variance)] {
+                for (band, i) in [
+                    (&mut bias_band, bv.relative_bias2),
+                    (&mut var_band, bv.relative_variance),
+                ] {
                     band.x.push(secs);
                     band.mean.push(i.mean);
                     band.lo.push(i.lo);
@@ -176,7 +219,11 @@ pub fn report(experiment: &Experiment, results: &ResultsDir, reference: &Referen
             .map(|region| {
                 let v: Vec<f64> = rows
                     .iter()
-                    .filter(|r| r.estimator == entry.label && r.region == region.label && r.checkpoint == last)
+                    .filter(|r| {
+                        r.estimator == entry.label
+                            && r.region == region.label
+                            && r.checkpoint == last
+                    })
                     .map(|r| r.relmse)
                     .collect();
                 (region.label.clone(), mean_interval(&v, CONFIDENCE))
@@ -199,11 +246,23 @@ pub fn report(experiment: &Experiment, results: &ResultsDir, reference: &Referen
             bias_variance,
             regions,
         });
-        by_seconds.push(Series { label: entry.label.clone(), band: band_s });
-        by_passes.push(Series { label: entry.label.clone(), band: band_p });
+        by_seconds.push(Series {
+            label: entry.label.clone(),
+            band: band_s,
+        });
+        by_passes.push(Series {
+            label: entry.label.clone(),
+            band: band_p,
+        });
         if !bias_band.x.is_empty() {
-            bias_series.push(Series { label: entry.label.clone(), band: bias_band });
-            variance_series.push(Series { label: entry.label.clone(), band: var_band });
+            bias_series.push(Series {
+                label: entry.label.clone(),
+                band: bias_band,
+            });
+            variance_series.push(Series {
+                label: entry.label.clone(),
+                band: var_band,
+            });
         }
     }
 
@@ -223,8 +282,22 @@ pub fn report(experiment: &Experiment, results: &ResultsDir, reference: &Referen
     let dir = &results.dir;
     let guides = [(-1.0, "slope −1"), (-2.0 / 3.0, "slope −2/3")];
     let title = format!("{}: relMSE", experiment.name);
-    convergence_plot(&dir.join("convergence"), &title, "seconds", "relMSE", &by_seconds, &guides)?;
-    convergence_plot(&dir.join("convergence-passes"), &title, "passes", "relMSE", &by_passes, &guides)?;
+    convergence_plot(
+        &dir.join("convergence"),
+        &title,
+        "seconds",
+        "relMSE",
+        &by_seconds,
+        &guides,
+    )?;
+    convergence_plot(
+        &dir.join("convergence-passes"),
+        &title,
+        "passes",
+        "relMSE",
+        &by_passes,
+        &guides,
+    )?;
     bias_variance_plot(
         &dir.join("bias"),
         &format!("{}: relative bias² and variance", experiment.name),
@@ -235,7 +308,13 @@ pub fn report(experiment: &Experiment, results: &ResultsDir, reference: &Referen
     let crops: Vec<Crop> = experiment
         .regions
         .iter()
-        .map(|r| Crop { label: r.label.clone(), x: r.x, y: r.y, width: r.width, height: r.height })
+        .map(|r| Crop {
+            label: r.label.clone(),
+            x: r.x,
+            y: r.y,
+            width: r.width,
+            height: r.height,
+        })
         .collect();
     contact_sheet(&dir.join("contact"), &reference.image, &sheet, &crops)?;
     write_png_preview(&dir.join("reference.png"), &reference.image)?;
@@ -243,18 +322,30 @@ pub fn report(experiment: &Experiment, results: &ResultsDir, reference: &Referen
     write_file_atomically(&dir.join("summary.csv"), summary_csv(&summary).as_bytes())?;
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     write_file_atomically(&dir.join("summary.json"), json.as_bytes())?;
-    write_file_atomically(&dir.join("README.md"), readme(experiment, &summary, reference).as_bytes())?;
+    write_file_atomically(
+        &dir.join("README.md"),
+        readme(experiment, &summary, reference).as_bytes(),
+    )?;
     Ok(summary)
 }
 
 /// `metrics.csv` with exactly DESIGN.md §6's columns.
 fn write_metrics_csv(path: &Path, rows: &[Row]) -> Result<()> {
-    let mut text = String::from("estimator,run,checkpoint,seconds,passes,samples,relmse,rmse,mape\n");
+    let mut text =
+        String::from("estimator,run,checkpoint,seconds,passes,samples,relmse,rmse,mape\n");
     for r in rows {
         let _ = writeln!(
             text,
             "{},{},{},{:.6},{},{},{:.9e},{:.9e},{:.9e}",
-            r.estimator, r.run, r.checkpoint, r.seconds, r.passes, r.samples, r.relmse, r.rmse, r.mape
+            r.estimator,
+            r.run,
+            r.checkpoint,
+            r.seconds,
+            r.passes,
+            r.samples,
+            r.relmse,
+            r.rmse,
+            r.mape
         );
     }
     write_file_atomically(path, text.as_bytes())
@@ -290,8 +381,10 @@ fn summary_csv(s: &Summary) -> String {
             opt(e.slope_passes.map(|f| f.slope)),
             opt(e.slope_passes.map(|f| f.slope_se)),
             i(&e.efficiency),
-            bv.map(|b| i(&b.relative_bias2)).unwrap_or_else(|| ",,".into()),
-            bv.map(|b| i(&b.relative_variance)).unwrap_or_else(|| ",,".into()),
+            bv.map(|b| i(&b.relative_bias2))
+                .unwrap_or_else(|| ",,".into()),
+            bv.map(|b| i(&b.relative_variance))
+                .unwrap_or_else(|| ",,".into()),
             opt(bv.map(|b| b.t_statistic)),
             opt(bv.map(|b| b.p_value)),
             e.below_reference_noise,
@@ -311,33 +404,56 @@ fn readme(experiment: &Experiment, s: &Summary, reference: &Reference) -> String
         md,
         "Scene `{}`, budget {} per run, {} checkpoints, {} runs per estimator. \
          Reproduce with `cargo run --release -- run {}`.\n",
-        experiment.scene.file_name().and_then(|f| f.to_str()).unwrap_or(""),
+        experiment
+            .scene
+            .file_name()
+            .and_then(|f| f.to_str())
+            .unwrap_or(""),
         s.budget,
         s.checkpoints,
         s.runs,
-        experiment.spec_path.file_stem().and_then(|f| f.to_str()).unwrap_or("")
+        experiment
+            .spec_path
+            .file_stem()
+            .and_then(|f| f.to_str())
+            .unwrap_or("")
     );
     let _ = writeln!(
         md,
         "Reference: `{}` ({}, {} passes, {:.0} s){}.\n",
-        reference.path.file_name().and_then(|f| f.to_str()).unwrap_or(""),
+        reference
+            .path
+            .file_name()
+            .and_then(|f| f.to_str())
+            .unwrap_or(""),
         reference.info.estimator,
         reference.info.passes,
         reference.info.seconds,
         match s.reference_noise_relmse {
-            Some(n) => format!(", its own noise relMSE ≈ {} (from two independent halves): errors below it are not meaningful", sci(n)),
+            Some(n) => format!(
+                ", its own noise relMSE ≈ {} (from two independent halves): errors below it are not meaningful",
+                sci(n)
+            ),
             None => ", its own noise unknown".into(),
         }
     );
     if !s.missing_cells.is_empty() {
-        let _ = writeln!(md, "**Incomplete:** no results yet for {}.\n", s.missing_cells.join(", "));
+        let _ = writeln!(
+            md,
+            "**Incomplete:** no results yet for {}.\n",
+            s.missing_cells.join(", ")
+        );
     }
     let _ = writeln!(
         md,
         "| estimator | runs | seconds | passes | relMSE (95% CI) | slope vs time | efficiency | rel. bias² | rel. variance | t-test p |\n|---|---|---|---|---|---|---|---|---|---|"
     );
     for e in &s.estimators {
-        let flag = if e.below_reference_noise { " ⚠ below reference noise" } else { "" };
+        let flag = if e.below_reference_noise {
+            " ⚠ below reference noise"
+        } else {
+            ""
+        };
         let bv = e.bias_variance.as_ref();
         let _ = writeln!(
             md,
@@ -354,17 +470,35 @@ fn readme(experiment: &Experiment, s: &Summary, reference: &Reference) -> String
                 .map(|f| format!("{:.2} ± {:.2}", f.slope, f.slope_se))
                 .unwrap_or_else(|| "–".into()),
             sci(e.efficiency.mean),
-            bv.map(|b| format!("{} [{}, {}]", sci(b.relative_bias2.mean), sci(b.relative_bias2.lo), sci(b.relative_bias2.hi)))
+            bv.map(|b| format!(
+                "{} [{}, {}]",
+                sci(b.relative_bias2.mean),
+                sci(b.relative_bias2.lo),
+                sci(b.relative_bias2.hi)
+            ))
+            .unwrap_or_else(|| "–".into()),
+            bv.map(|b| sci(b.relative_variance.mean))
                 .unwrap_or_else(|| "–".into()),
-            bv.map(|b| sci(b.relative_variance.mean)).unwrap_or_else(|| "–".into()),
-            bv.map(|b| format!("{:.3}", b.p_value)).unwrap_or_else(|| "–".into()),
+            bv.map(|b| format!("{:.3}", b.p_value))
+                .unwrap_or_else(|| "–".into()),
         );
     }
     for region in &experiment.regions {
-        let _ = writeln!(md, "\nRegion **{}** ({}×{} at {}, {}), final relMSE:", region.label, region.width, region.height, region.x, region.y);
+        let _ = writeln!(
+            md,
+            "\nRegion **{}** ({}×{} at {}, {}), final relMSE:",
+            region.label, region.width, region.height, region.x, region.y
+        );
         for e in &s.estimators {
             if let Some((_, i)) = e.regions.iter().find(|(l, _)| *l == region.label) {
-                let _ = writeln!(md, "- {}: {} [{}, {}]", e.label, sci(i.mean), sci(i.lo), sci(i.hi));
+                let _ = writeln!(
+                    md,
+                    "- {}: {} [{}, {}]",
+                    e.label,
+                    sci(i.mean),
+                    sci(i.lo),
+                    sci(i.hi)
+                );
             }
         }
     }
@@ -379,6 +513,9 @@ fn readme(experiment: &Experiment, s: &Summary, reference: &Reference) -> String
     let _ = writeln!(md, "![relMSE against passes](convergence-passes.png)\n");
     let _ = writeln!(md, "![bias² and variance against time](bias.png)\n");
     let _ = writeln!(md, "![final images and relative-error maps](contact.png)\n");
-    let _ = writeln!(md, "Data: `metrics.csv` (every checkpoint of every run), `summary.csv`, `summary.json`.");
+    let _ = writeln!(
+        md,
+        "Data: `metrics.csv` (every checkpoint of every run), `summary.csv`, `summary.json`."
+    );
     md
 }

@@ -87,8 +87,14 @@ impl Row {
         if f.len() != 10 {
             return Err(fail("expected 10 fields"));
         }
-        let num = |i: usize| f[i].parse::<f64>().map_err(|_| fail("a field is not a number"));
-        let int = |i: usize| f[i].parse::<u64>().map_err(|_| fail("a field is not an integer"));
+        let num = |i: usize| {
+            f[i].parse::<f64>()
+                .map_err(|_| fail("a field is not a number"))
+        };
+        let int = |i: usize| {
+            f[i].parse::<u64>()
+                .map_err(|_| fail("a field is not an integer"))
+        };
         Ok(Row {
             estimator: f[0].to_string(),
             run: int(1)? as u32,
@@ -165,7 +171,6 @@ impl ResultsDir {
             .join("images")
             .join(format!("{}-run{run}.exr", file_label(label)))
     }
-
 }
 
 /// Loads the experiment's scene with its parameters.
@@ -211,7 +216,10 @@ pub fn obtain_reference(
                 if r.info.key != key {
                     return Err(Error::input(
                         Location::file(path.with_extension("json")),
-                        format!("cached reference has key {} but {key} was expected", r.info.key),
+                        format!(
+                            "cached reference has key {} but {key} was expected",
+                            r.info.key
+                        ),
                     ));
                 }
                 r
@@ -309,7 +317,12 @@ pub fn clear_results(results: &ResultsDir) -> Result<()> {
 }
 
 /// True when cell (estimator `e`, run `r`) has all its checkpoint rows and final image.
-pub fn cell_is_complete(experiment: &Experiment, results: &ResultsDir, e: usize, r: u32) -> Result<bool> {
+pub fn cell_is_complete(
+    experiment: &Experiment,
+    results: &ResultsDir,
+    e: usize,
+    r: u32,
+) -> Result<bool> {
     let label = &experiment.estimators[e].label;
     let csv = results.cell_csv(label, r);
     if !csv.exists() || !results.final_image(label, r).exists() {
@@ -326,16 +339,17 @@ pub fn run_seed(experiment: &Experiment, label: &str, run: u32) -> u64 {
     hash_words(&[experiment.seed, label_hash, run as u64])
 }
 
-/// Renders one cell to its last checkpoint, writing its rows and images as it goes.
-/// `on_pass()` is called after every pass (progress).
+/// Renders cell (estimator `e`, `run`) to its last checkpoint, writing its rows and images
+/// as it goes; `after_checkpoint` runs once each checkpoint's files are written (an error
+/// from it stops the cell there).
 pub fn run_cell(
     experiment: &Experiment,
     scene: &Scene,
     reference: &Reference,
     results: &ResultsDir,
-    e: usize,
-    run: u32,
+    (e, run): (usize, u32),
     bar: &ProgressBar,
+    after_checkpoint: &mut dyn FnMut() -> Result<()>,
 ) -> Result<Vec<Row>> {
     let entry = &experiment.estimators[e];
     let params = Params::parse(&entry.params)?;
@@ -350,7 +364,11 @@ pub fn run_cell(
             .parent()
             .unwrap()
             .to_path_buf(),
-        results.final_image(&entry.label, run).parent().unwrap().to_path_buf(),
+        results
+            .final_image(&entry.label, run)
+            .parent()
+            .unwrap()
+            .to_path_buf(),
     ] {
         std::fs::create_dir_all(&dir).map_err(|e| Error::io(&dir, e))?;
     }
@@ -418,8 +436,12 @@ pub fn run_cell(
                 metrics_in(&image, &reference.image, *region)?,
             ));
         }
-        write_exr(&results.checkpoint_image(&entry.label, run, k as u32), &image)?;
+        write_exr(
+            &results.checkpoint_image(&entry.label, run, k as u32),
+            &image,
+        )?;
         write_rows(&csv, &rows)?;
+        after_checkpoint()?;
     }
     let final_path = results.final_image(&entry.label, run);
     write_exr(&final_path, &image)?;

@@ -198,7 +198,7 @@ impl Experiment {
             ));
         }
         let scale = if quick { file.quick.scale } else { 1.0 };
-        let budget = budget(&file.budget, "budget", scale).map_err(fail)?;
+        let budget = parse_budget(&file.budget, "budget", scale).map_err(fail)?;
         let runs = if quick {
             file.runs.min(file.quick.runs)
         } else {
@@ -244,13 +244,14 @@ impl Experiment {
             }
             (None, Some(estimator)) => {
                 check_estimator_name(estimator).map_err(fail)?;
-                let b = file.reference.budget.ok_or_else(|| {
-                    fail("[reference] with an estimator needs a budget".into())
-                })?;
+                let b = file
+                    .reference
+                    .budget
+                    .ok_or_else(|| fail("[reference] with an estimator needs a budget".into()))?;
                 ReferenceSource::Render {
                     estimator: estimator.clone(),
                     params: params_to_strings(&file.reference.params).map_err(fail)?,
-                    budget: budget(&b, "reference.budget", scale).map_err(fail)?,
+                    budget: parse_budget(&b, "reference.budget", scale).map_err(fail)?,
                 }
             }
             _ => {
@@ -333,7 +334,7 @@ impl Experiment {
     }
 }
 
-fn budget(b: &BudgetFile, what: &str, scale: f64) -> std::result::Result<Budget, String> {
+fn parse_budget(b: &BudgetFile, what: &str, scale: f64) -> std::result::Result<Budget, String> {
     match (b.seconds, b.passes) {
         (Some(s), None) if s.is_finite() && s > 0.0 => Ok(Budget::Seconds(s * scale)),
         (None, Some(p)) if p > 0 => Ok(Budget::Passes(((p as f64 * scale).ceil() as u32).max(1))),
@@ -388,6 +389,12 @@ fn value_to_string(key: &str, v: &toml::Value) -> std::result::Result<String, St
 pub fn file_label(label: &str) -> String {
     label
         .chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '.' || c == '-' { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '.' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect()
 }

@@ -1,0 +1,254 @@
+//! The experiment harness end to end on a 32×32 Cornell box: files and plots written, an
+//! interrupted run resumed to the same rows, cells run one by one and merged by `report`
+//! to the same summary as one `run`, and bad specs or results files give errors.
+
+use std::path::{Path, PathBuf};
+
+use indicatif::ProgressBar;
+use mltbench::experiment::runner::read_rows;
+use mltbench::experiment::{self, Experiment, RunOptions};
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("mltbench-exp-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn scene_path() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/scenes/cbox.xml")
+}
+
+/// A tiny experiment with a pass budget (reproducible bit for bit).
+fn tiny_spec(dir: &Path, budget: &str) -> PathBuf {
+    tiny_spec_with_reference(dir, budget, 64)
+}
+
+fn tiny_spec_with_reference(dir: &Path, budget: &str, reference_passes: u32) -> PathBuf {
+    let spec = format!(
+        r#"description = "tiny test experiment"
+scene = "{}"
+scene_params = {{ res = 32, max_depth = 4 }}
+budget = {budget}
+checkpoints = 6
+runs = 2
+seed = 3
+
+[reference]
+estimator = "pt"
+budget = {{ passes = {reference_passes} }}
+
+[[estimator]]
+name = "pt"
+
+[[estimator]]
+name = "eyelight"
+label = "preview (biased)"
+
+[[region]]
+label = "light"
+x = 12
+y = 0
+width = 8
+height = 4
+"#,
+        scene_path().display()
+    );
+    let path = dir.join("tiny.toml");
+    std::fs::write(&path, spec).unwrap();
+    path
+}
+
+fn options(results: &Path) -> RunOptions {
+    RunOptions {
+        results_root: results.to_path_buf(),
+        fresh: false,
+        cell: None,
+        stop_after_checkpoints: None,
+    }
+}
+
+/// metrics.csv without the seconds column (timing differs between any two runs).
+fn rows_without_time(results: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(results.join("tiny/metrics.csv")).unwrap();
+    text.lines()
+        .map(|l| {
+            let mut f: Vec<&str> = l.split(',').collect();
+            f.remove(3);
+            f.join(",")
+        })
+        .collect()
+}
+
+#[test]
+fn a_tiny_experiment_runs_end_to_end_and_its_plots_decode() {
+    let dir = temp_dir("e2e");
+    // A reference far longer than the runs, so that their error is not the reference's.
+    let spec = tiny_spec_with_reference(&dir, "{ seconds = 0.1 }", 4096);
+    let exp = Experiment::load(&spec, false).unwrap();
+    let results = dir.join("results");
+    let summary = experiment::run(&exp, &options(&results), &ProgressBar::hidden())
+        .unwrap()
+        .unwrap();
+    let out = results.join("tiny");
+    for f in [
+        "metrics.csv",
+        "regions.csv",
+        "summary.csv",
+        "summary.json",
+        "README.md",
+        "convergence.svg",
+        "convergence-passes.svg",
+        "bias.svg",
+    ] {
+        assert!(out.join(f).is_file(), "{f} missing");
+    }
+    for png in [
+        "convergence.png",
+        "convergence-passes.png",
+        "bias.png",
+        "contact.png",
+    ] {
+        let file = std::fs::File::open(out.join(png)).unwrap();
+        let mut reader = png::Decoder::new(std::io::BufReader::new(file))
+            .read_info()
+            .unwrap();
+        let mut buf = vec![0; reader.output_buffer_size().unwrap()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert!(info.width > 100 && info.height > 100, "{png}");
+    }
+    // 2 estimators × 2 runs × 6 checkpoints.
+    assert_eq!(read_rows_count(&out.join("metrics.csv")), 24);
+    let pt = &summary.estimators[0];
+    let preview = &summary.estimators[1];
+    // The preview is biased: far larger error, and its error does not fall with time.
+    assert!(preview.relmse.mean > 10.0 * pt.relmse.mean);
+    assert!(pt.slope_passes.unwrap().slope < -0.5);
+    assert!(preview.slope_passes.unwrap().slope.abs() < 0.2);
+    let readme = std::fs::read_to_string(out.join("README.md")).unwrap();
+    assert!(readme.contains("convergence.png") && readme.contains("preview (biased)"));
+}
+
+fn read_rows_count(path: &Path) -> usize {
+    std::fs::read_to_string(path).unwrap().lines().count() - 1
+}
+
+#[test]
+fn an_interrupted_run_resumes_to_the_same_rows() {
+    let dir = temp_dir("resume");
+    let exp = Experiment::load(&tiny_spec(&dir, "{ passes = 12 }"), false).unwrap();
+    let whole = dir.join("whole");
+    experiment::run(&exp, &options(&whole), &ProgressBar::hidden()).unwrap();
+
+    let interrupted = dir.join("interrupted");
+    let mut stop = options(&interrupted);
+    stop.stop_after_checkpoints = Some(2);
+    let err = experiment::run(&exp, &stop, &ProgressBar::hidden()).unwrap_err();
+    assert!(err.to_string().contains("interrupted"), "{err}");
+    // The two finished checkpoints are on disk.
+    let cell = interrupted.join("tiny/cells/pt-run0.csv");
+    assert_eq!(
+        read_rows(&cell)
+            .unwrap()
+            .iter()
+            .filter(|r| r.region.is_empty())
+            .count(),
+        2
+    );
+
+    experiment::run(&exp, &options(&interrupted), &ProgressBar::hidden()).unwrap();
+    assert_eq!(rows_without_time(&whole), rows_without_time(&interrupted));
+}
+
+#[test]
+fn cells_run_one_by_one_then_reported_match_a_single_run() {
+    let dir = temp_dir("cells");
+    let exp = Experiment::load(&tiny_spec(&dir, "{ passes = 8 }"), false).unwrap();
+    let single = dir.join("single");
+    let one = experiment::run(&exp, &options(&single), &ProgressBar::hidden())
+        .unwrap()
+        .unwrap();
+
+    let split = dir.join("split");
+    for k in 0..exp.cells().len() {
+        let mut o = options(&split);
+        o.cell = Some(k);
+        assert!(
+            experiment::run(&exp, &o, &ProgressBar::hidden())
+                .unwrap()
+                .is_none()
+        );
+    }
+    let merged = experiment::report_only(&exp, &split, &ProgressBar::hidden()).unwrap();
+    assert_eq!(rows_without_time(&single), rows_without_time(&split));
+    assert!(merged.missing_cells.is_empty());
+    for (a, b) in one.estimators.iter().zip(&merged.estimators) {
+        assert_eq!(a.label, b.label);
+        assert_eq!(a.relmse, b.relmse);
+        assert_eq!(a.rmse, b.rmse);
+        assert_eq!(a.mape, b.mape);
+        assert_eq!(a.slope_passes, b.slope_passes);
+        assert_eq!(a.bias_variance, b.bias_variance);
+        assert_eq!(a.regions, b.regions);
+    }
+}
+
+#[test]
+fn bad_specs_and_corrupt_results_are_errors_naming_the_file() {
+    let dir = temp_dir("bad");
+    let good = std::fs::read_to_string(tiny_spec(&dir, "{ passes = 4 }")).unwrap();
+    let cases = [
+        (
+            "unknown key",
+            good.replace("runs = 2", "runs = 2\nrunz = 3"),
+        ),
+        (
+            "unknown estimator",
+            good.replace("name = \"eyelight\"", "name = \"nope\""),
+        ),
+        (
+            "both budgets",
+            good.replace("{ passes = 4 }", "{ passes = 4, seconds = 1 }"),
+        ),
+        (
+            "duplicate label",
+            good.replace("label = \"preview (biased)\"", "label = \"pt\""),
+        ),
+        ("no reference", good.replace("budget = { passes = 64 }", "")),
+        ("zero runs", good.replace("runs = 2", "runs = 0")),
+        (
+            "malformed",
+            good.replace("checkpoints = 6", "checkpoints = = 6"),
+        ),
+    ];
+    for (what, text) in cases {
+        let path = dir.join(format!("{}.toml", what.replace(' ', "_")));
+        std::fs::write(&path, text).unwrap();
+        let err = Experiment::load(&path, false).unwrap_err().to_string();
+        assert!(
+            err.contains(path.file_name().unwrap().to_str().unwrap()),
+            "{what}: {err}"
+        );
+    }
+
+    // A corrupt cell file in the results: an error naming it, not a panic.
+    let spec = tiny_spec(&dir, "{ passes = 4 }");
+    let exp = Experiment::load(&spec, false).unwrap();
+    let results = dir.join("results");
+    experiment::run(&exp, &options(&results), &ProgressBar::hidden()).unwrap();
+    let cell = results.join("tiny/cells/pt-run1.csv");
+    std::fs::write(&cell, "garbage,\u{0}\n1,2,3\n").unwrap();
+    let err = experiment::report_only(&exp, &results, &ProgressBar::hidden())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("pt-run1.csv"), "{err}");
+
+    // A changed experiment does not mix with earlier results.
+    let changed = spec.with_file_name("tiny.toml");
+    std::fs::write(&changed, good.replace("seed = 3", "seed = 4")).unwrap();
+    let exp2 = Experiment::load(&changed, false).unwrap();
+    let err = experiment::run(&exp2, &options(&results), &ProgressBar::hidden())
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("--fresh"), "{err}");
+}
