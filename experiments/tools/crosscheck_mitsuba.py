@@ -267,6 +267,7 @@ def compare(x, y):
     relmse = float(np.mean((x - y) ** 2 / (y * y + 0.01)))
     nonfinite = int(np.count_nonzero(~np.isfinite(x))), int(np.count_nonzero(~np.isfinite(y)))
     return {
+        "blocks": block_z(x, y),
         "mean_x": mx,
         "mean_y": my,
         "ratio": ratio,
@@ -275,6 +276,34 @@ def compare(x, y):
         "relmse": relmse,
         "nonfinite": nonfinite,
     }
+
+
+def block_z(x, y, size=16):
+    """z-scores of the mean difference over size x size pixel blocks (channels averaged).
+
+    A whole-image mean can hide opposite local errors; per block, the mean difference over
+    its standard error (std of the block's per-pixel differences / sqrt(pixels)) is N(0, 1)
+    if the two renderers agree there. Returns (number of blocks, std of z, largest |z|,
+    that block's pixel rectangle) or None if the image has fewer than 4 blocks.
+    """
+    import numpy as np
+
+    h, w = (x.shape[0] // size) * size, (x.shape[1] // size) * size
+    if h // size * (w // size) < 4:
+        return None
+    d = (x[:h, :w] - y[:h, :w]).mean(axis=2)
+    d = d.reshape(h // size, size, w // size, size).transpose(0, 2, 1, 3).reshape(
+        h // size, w // size, size * size
+    )
+    se = d.std(axis=2, ddof=1) / size
+    with np.errstate(divide="ignore", invalid="ignore"):
+        z = np.where(se > 0, d.mean(axis=2) / se, np.nan)
+    ok = np.isfinite(z)
+    if ok.sum() < 4:
+        return None
+    by, bx = np.unravel_index(np.nanargmax(np.abs(z)), z.shape)
+    rect = (bx * size, by * size, bx * size + size - 1, by * size + size - 1)
+    return int(ok.sum()), float(np.nanstd(z)), float(abs(z[by, bx])), rect
 
 
 def fit_spp(spps, relmses):
@@ -310,6 +339,12 @@ def print_block(variant, spp, cmp, mits, mrun, mlt, threads):
     print(f"{'  sigma (paired)':22}" + "".join(f"{v:12.5f}" for v in cmp["sigma_paired"]))
     z = [(r - 1.0) / s if s > 0 else math.nan for r, s in zip(cmp["ratio"], cmp["sigma_paired"])]
     print(f"{'  (ratio-1)/sigma_p':22}" + "".join(f"{v:12.2f}" for v in z))
+    if cmp["blocks"] is not None:
+        n, zstd, zmax, (x0, y0, x1, y1) = cmp["blocks"]
+        # For n independent N(0,1) values the largest |z| is about sqrt(2 ln n).
+        print(f"16x16-pixel blocks    z std {zstd:.2f} over {n} blocks (1 if they agree "
+              f"everywhere); largest |z| {zmax:.1f} (expect ~{math.sqrt(2 * math.log(n)):.1f})"
+              f" at pixels x {x0}-{x1}, y {y0}-{y1}")
     print(f"relMSE (y = Mitsuba)  {cmp['relmse']:.6g}")
     if any(cmp["nonfinite"]):
         print(f"  warning: non-finite values: {cmp['nonfinite'][0]} in mltbench, "
