@@ -6,6 +6,7 @@
 pub mod camera;
 pub mod error;
 pub mod estimator;
+pub mod experiment;
 pub mod film;
 pub mod geometry;
 pub mod image;

@@ -1,0 +1,3 @@
+//! The experiment harness: named experiments pitting estimators against a reference.
+
+pub mod plot;
