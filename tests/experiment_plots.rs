@@ -267,7 +267,17 @@ fn empty_and_nan_data_give_valid_plots() {
     )
     .unwrap();
     let (_, texts) = check_plot(&dir, "nan");
-    for want in ["broken", "all NaN (no data)", "one point"] {
+    // Short axes: ticks at 1, 2, 5 × 10ⁿ, labelled as plain numbers.
+    for want in [
+        "broken",
+        "all NaN (no data)",
+        "one point",
+        "0.1",
+        "0.2",
+        "0.5",
+        "2",
+        "5",
+    ] {
         assert!(texts.iter().any(|t| t == want), "no {want:?} in {texts:?}");
     }
     assert!(
