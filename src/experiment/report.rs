@@ -479,7 +479,11 @@ fn readme(experiment: &Experiment, s: &Summary, reference: &Reference) -> String
                     sci(b.relative_bias2.mean),
                     sci(b.relative_bias2.lo),
                     sci(b.relative_bias2.hi),
-                    if within_noise { " (within ref. noise)" } else { "" }
+                    if within_noise {
+                        " (within ref. noise)"
+                    } else {
+                        ""
+                    }
                 )
             })
             .unwrap_or_else(|| "–".into()),
