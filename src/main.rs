@@ -87,10 +87,8 @@ struct ReportArgs {
 
 #[derive(clap::Args)]
 struct ReferenceArgs {
-    /// The scene: a Mitsuba 3 XML file.
-    scene: PathBuf,
-    #[arg(short, long, value_name = "NAME", help = estimator_help())]
-    estimator: String,
+    #[command(flatten)]
+    common: SceneEstimatorArgs,
     /// Passes in all (each half renders half of them).
     #[arg(
         long,
@@ -102,14 +100,6 @@ struct ReferenceArgs {
     /// Seconds in all (each half renders half of them).
     #[arg(long, value_name = "SECONDS")]
     time: Option<f64>,
-    #[arg(long, default_value_t = 0)]
-    seed: u64,
-    #[arg(long, value_name = "N")]
-    threads: Option<usize>,
-    #[arg(long = "set", value_name = "KEY=VALUE")]
-    set: Vec<String>,
-    #[arg(short = 'D', long = "define", value_name = "NAME=VALUE")]
-    define: Vec<String>,
     /// Output EXR (default: <scene name>-reference.exr); OUT.json and OUT.png beside it.
     #[arg(short, long, value_name = "OUT.exr")]
     output: Option<PathBuf>,
@@ -121,19 +111,14 @@ struct CompareArgs {
     reference: PathBuf,
 }
 
+/// What `render` and `reference` share: the scene, the estimator and how it runs.
 #[derive(clap::Args)]
-struct RenderArgs {
+struct SceneEstimatorArgs {
     /// The scene: a Mitsuba 3 XML file.
     scene: PathBuf,
     /// Which estimator renders it.
     #[arg(short, long, value_name = "NAME", help = estimator_help())]
     estimator: String,
-    /// Samples per pixel (passes). Default: the scene's <sampler sample_count>.
-    #[arg(long, value_name = "N", conflicts_with = "time")]
-    spp: Option<u32>,
-    /// Render for this many seconds of wall-clock time instead of a fixed spp.
-    #[arg(long, value_name = "SECONDS")]
-    time: Option<f64>,
     /// Seed of every random stream; the same seed gives the same image.
     #[arg(long, default_value_t = 0)]
     seed: u64,
@@ -147,6 +132,18 @@ struct RenderArgs {
     /// (as Mitsuba's -D). Naming a parameter the scene does not declare is an error.
     #[arg(short = 'D', long = "define", value_name = "NAME=VALUE")]
     define: Vec<String>,
+}
+
+#[derive(clap::Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    common: SceneEstimatorArgs,
+    /// Samples per pixel (passes). Default: the scene's <sampler sample_count>.
+    #[arg(long, value_name = "N", conflicts_with = "time")]
+    spp: Option<u32>,
+    /// Render for this many seconds of wall-clock time instead of a fixed spp.
+    #[arg(long, value_name = "SECONDS")]
+    time: Option<f64>,
     /// Output EXR. Default: <scene name>.exr in the working directory. A PNG preview is
     /// written beside it.
     #[arg(short, long, value_name = "OUT.exr")]
@@ -177,7 +174,7 @@ fn main() -> ExitCode {
 }
 
 fn run_render(args: RenderArgs) -> Result<()> {
-    let params = Params::parse(&args.set)?;
+    let params = Params::parse(&args.common.set)?;
     if let Some(t) = args.time
         && !(t.is_finite() && t > 0.0)
     {
@@ -191,7 +188,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
     let output = args
         .output
         .clone()
-        .unwrap_or_else(|| default_output(&args.scene));
+        .unwrap_or_else(|| default_output(&args.common.scene));
     if output.extension().and_then(|e| e.to_str()) != Some("exr") {
         return Err(Error::usage(format!(
             "output {} must end in .exr",
@@ -199,15 +196,15 @@ fn run_render(args: RenderArgs) -> Result<()> {
         )));
     }
 
-    let scene_params = parse_defines(&args.define)?;
-    let description = mitsuba::load_file_with(&args.scene, &scene_params)?;
+    let scene_params = parse_defines(&args.common.define)?;
+    let description = mitsuba::load_file_with(&args.common.scene, &scene_params)?;
     for warning in &description.warnings {
         eprintln!("warning: {warning}");
     }
     if description.skipped_triangles > 0 {
         eprintln!(
             "warning: {}: skipped {} degenerate triangles",
-            args.scene.display(),
+            args.common.scene.display(),
             description.skipped_triangles
         );
     }
@@ -219,10 +216,16 @@ fn run_render(args: RenderArgs) -> Result<()> {
     };
 
     let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.threads.unwrap_or(0))
+        .num_threads(args.common.threads.unwrap_or(0))
         .build()
-        .map_err(|e| Error::usage(format!("cannot start {:?} threads: {e}", args.threads)))?;
-    let mut estimator = estimator::create(&args.estimator, &params, &scene, args.seed)?;
+        .map_err(|e| {
+            Error::usage(format!(
+                "cannot start {:?} threads: {e}",
+                args.common.threads
+            ))
+        })?;
+    let mut estimator =
+        estimator::create(&args.common.estimator, &params, &scene, args.common.seed)?;
 
     let bar = progress_bar(budget);
     let result = pool.install(|| {
@@ -249,7 +252,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
     eprintln!(
         "{}: {} passes, {} samples, {:.2} s ({:.3} M samples/s, {:.3} M rays/s), \
          {} invalid samples dropped -> {} (+ {})",
-        args.estimator,
+        args.common.estimator,
         stats.passes,
         stats.samples,
         result.seconds,
@@ -360,7 +363,7 @@ fn report_experiment(args: ReportArgs) -> Result<()> {
 }
 
 fn render_reference(args: ReferenceArgs) -> Result<()> {
-    Params::parse(&args.set)?; // rejects a malformed --set before any rendering
+    Params::parse(&args.common.set)?; // rejects a malformed --set before any rendering
     let budget = match (args.spp, args.time) {
         (_, Some(t)) if t.is_finite() && t > 0.0 => Budget::Seconds(t),
         (Some(n), None) if n >= 2 => Budget::Passes(n),
@@ -372,6 +375,7 @@ fn render_reference(args: ReferenceArgs) -> Result<()> {
     };
     let output = args.output.clone().unwrap_or_else(|| {
         let stem = args
+            .common
             .scene
             .file_stem()
             .and_then(|s| s.to_str())
@@ -379,24 +383,24 @@ fn render_reference(args: ReferenceArgs) -> Result<()> {
         PathBuf::from(format!("{stem}-reference.exr"))
     });
     let scene = Scene::build(mitsuba::load_file_with(
-        &args.scene,
-        &parse_defines(&args.define)?,
+        &args.common.scene,
+        &parse_defines(&args.common.define)?,
     )?)?;
-    let pool = thread_pool(args.threads)?;
+    let pool = thread_pool(args.common.threads)?;
     let bar = experiment_bar();
     let rendered = pool.install(|| {
         experiment::reference::render_reference(
             &scene,
-            &args.estimator,
-            &args.set,
+            &args.common.estimator,
+            &args.common.set,
             budget,
-            args.seed,
+            args.common.seed,
             |half, pass| bar.set_message(format!("half {}/2, pass {pass}", half + 1)),
         )
     });
     bar.finish_and_clear();
     let (image, mut info) = rendered?;
-    info.scene = args.scene.display().to_string();
+    info.scene = args.common.scene.display().to_string();
     experiment::reference::save(&output, &image, &info)?;
     eprintln!(
         "reference: {} passes, {:.1} s, own noise relMSE ≈ {:.3e} -> {} (+ .json, .png)",
