@@ -175,18 +175,21 @@ impl TriangleBvh {
             let [shape, primitive] = source.ids(i as usize);
             TriangleRecord::new(source.vertices(i as usize), shape, primitive)
         }));
-        // Read once per closest hit (and prefetched): ordinary pages.
+        // Read once per closest hit, but prefetched at every candidate hit: a prefetch that
+        // misses the TLB stalls like a load, so these get huge pages too.
         let normals = source.has_normals().then(|| {
-            order
-                .par_iter()
-                .map(|&i| source.normals(i as usize).unwrap_or([Vec3::ZERO; 3]))
-                .collect()
+            collect_large(
+                order
+                    .par_iter()
+                    .map(|&i| source.normals(i as usize).unwrap_or([Vec3::ZERO; 3])),
+            )
         });
         let uvs = source.has_uvs().then(|| {
-            order
-                .par_iter()
-                .map(|&i| source.uvs(i as usize).unwrap_or([Vec2::NAN; 3]))
-                .collect()
+            collect_large(
+                order
+                    .par_iter()
+                    .map(|&i| source.uvs(i as usize).unwrap_or([Vec2::NAN; 3])),
+            )
         });
         let nodes = collect_large(wide.nodes.par_iter().copied());
         TriangleBvh {
