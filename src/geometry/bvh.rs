@@ -234,6 +234,7 @@ impl TriangleBvh {
     }
 
     /// Closest triangle with 0 < t < t_max: (record index, its hit data).
+    #[inline(always)]
     pub fn closest(&self, ray: &TraversalRay, t_max: f32) -> Option<(u32, TriangleHit)> {
         if self.nodes.is_empty() {
             return None;
@@ -263,6 +264,7 @@ impl TriangleBvh {
     }
 
     /// True when some triangle lies at 0 < t < t_max.
+    #[inline(always)]
     pub fn any(&self, ray: &TraversalRay, t_max: f32) -> bool {
         if self.nodes.is_empty() {
             return false;
