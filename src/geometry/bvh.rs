@@ -362,12 +362,16 @@ impl TriangleBvh {
             // The hit leaves' triangles are contiguous: their first and last lines.
             let first = node.primitive_base_idx + tris.trailing_zeros();
             let last = node.primitive_base_idx + 31 - tris.leading_zeros();
-            if let (Some(a), Some(b)) = (
-                self.records.get(first as usize),
-                self.records.get(last as usize),
-            ) {
-                prefetch(a);
-                prefetch(b);
+            if let Some(run) = self.records.get(first as usize..=last as usize) {
+                // Every cache line of the run, not just its ends (leaves of several nodes'
+                // worth of triangles span several lines); at most 8 lines.
+                let start = run.as_ptr() as usize;
+                let end = start + std::mem::size_of_val(run);
+                let mut line = start & !63;
+                while line < end.min(start + 8 * 64) {
+                    prefetch_address(line);
+                    line += 64;
+                }
             }
         }
     }
@@ -511,6 +515,19 @@ fn prefetch<T>(v: &T) {
     }
     #[cfg(not(target_arch = "x86_64"))]
     let _ = v;
+}
+
+/// Hint the CPU to bring the cache line at `address` in (never faults, any address).
+#[inline(always)]
+fn prefetch_address(address: usize) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch is only a hint: it never faults, whatever the address.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>(address as *const i8);
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = address;
 }
 
 trait TraversalStack {
