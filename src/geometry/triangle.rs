@@ -91,17 +91,16 @@ impl TriangleRay {
         // Branch-free, and without indexing arrays on the stack (a store and a reload per
         // lookup): ray directions are random, branches on them mispredict.
         let a = d.abs();
-        // kz = index of the largest |d| component (the first of equals, as a scan would).
-        let kz = if a.z > a.x.max(a.y) {
-            2
-        } else {
-            (a.y > a.x) as usize
-        };
-        let kx0 = if kz == 2 { 0 } else { kz + 1 };
-        let ky0 = if kz == 0 { 2 } else { kz - 1 };
+        // kz = index of the largest |d| component (the first of equals, as a scan would),
+        // in integer arithmetic (compilers turn selects on it into branches).
+        let z_largest = (a.z > a.x.max(a.y)) as usize;
+        let kz = 2 * z_largest + (1 - z_largest) * (a.y > a.x) as usize;
+        let kx0 = [1, 2, 0][kz];
+        let ky0 = [2, 0, 1][kz];
         // A negative d[kz] swaps x and y to keep the winding.
-        let negative = (d.cmplt(Vec3::ZERO).bitmask() >> kz) & 1 != 0;
-        let (kx, ky) = if negative { (ky0, kx0) } else { (kx0, ky0) };
+        let negative = (d.cmplt(Vec3::ZERO).bitmask() as usize >> kz) & 1;
+        let swap = (kx0 ^ ky0) & negative.wrapping_neg();
+        let (kx, ky) = (kx0 ^ swap, ky0 ^ swap);
         let (op, dp) = permute(o, d, [kx, ky, kz]);
         let sz = 1.0 / dp.z;
         TriangleRay {
