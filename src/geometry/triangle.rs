@@ -165,7 +165,8 @@ impl TriangleHit {
 /// In f64 from the f32 inputs: the differences are exact, the cross product rounds once,
 /// the dot products a few times, all relative to ~2⁻⁵², so the sign is wrong only for an
 /// origin within ~1e-15·|v0 − o| of the plane (spawned origins sit ~1e-7 away).
-#[inline(never)]
+/// Inlined: a call would spill every vector register the traversal keeps live.
+#[inline(always)]
 fn t_is_positive(tri: &TriangleRecord, r: &TriangleRay) -> bool {
     let v = [0, 1, 2].map(|i| tri.vertex(i).as_dvec3());
     let n = (v[1] - v[0]).cross(v[2] - v[0]);
