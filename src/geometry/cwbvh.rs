@@ -243,14 +243,25 @@ fn choose_children(bvh2: &Bvh2, b: u32) -> ([u32; 8], usize) {
     }
     children[0] = node.first_index;
     children[1] = node.first_index + 1;
+    // Half areas of the children that can be opened (−∞ for leaves), kept beside them.
+    let openable = |c: u32| {
+        let n = &n2[c as usize];
+        if n.is_leaf() {
+            f32::NEG_INFINITY
+        } else {
+            n.aabb().half_area()
+        }
+    };
+    let mut area = [f32::NEG_INFINITY; 8];
+    area[0] = openable(children[0]);
+    area[1] = openable(children[1]);
     let mut len = 2;
     while len < 8 {
         let mut open = None;
         let mut largest = f32::NEG_INFINITY;
-        for (i, &c) in children[..len].iter().enumerate() {
-            let n = &n2[c as usize];
-            if !n.is_leaf() && n.aabb().half_area() > largest {
-                largest = n.aabb().half_area();
+        for (i, &a) in area[..len].iter().enumerate() {
+            if a > largest {
+                largest = a;
                 open = Some(i);
             }
         }
@@ -258,6 +269,8 @@ fn choose_children(bvh2: &Bvh2, b: u32) -> ([u32; 8], usize) {
         let first = n2[children[i] as usize].first_index;
         children[i] = first;
         children[len] = first + 1;
+        area[i] = openable(first);
+        area[len] = openable(first + 1);
         len += 1;
     }
     (children, len)
@@ -270,10 +283,11 @@ fn choose_children(bvh2: &Bvh2, b: u32) -> ([u32; 8], usize) {
 fn order_children(bvh2: &Bvh2, b: u32, children: &[u32]) -> [Option<u32>; 8] {
     let n2 = &bvh2.nodes;
     let center = n2[b as usize].aabb().center();
-    let mut cost = [[0.0f32; 8]; 8];
+    // cost[8c + s]; taken pairs and the rows and columns they use are set to +∞.
+    let mut cost = [f32::INFINITY; 64];
     for (c, &child) in children.iter().enumerate() {
         let v = n2[child as usize].aabb().center() - center;
-        for (s, cost) in cost[c].iter_mut().enumerate() {
+        for (s, cost) in cost[8 * c..8 * c + 8].iter_mut().enumerate() {
             let d = Vec3A::new(
                 if s & 4 != 0 { -1.0 } else { 1.0 },
                 if s & 2 != 0 { -1.0 } else { 1.0 },
@@ -283,22 +297,17 @@ fn order_children(bvh2: &Bvh2, b: u32, children: &[u32]) -> [Option<u32>; 8] {
         }
     }
     let mut slots = [None; 8];
-    let mut assigned = [false; 8];
     for _ in 0..children.len() {
-        let mut best = (f32::INFINITY, 0, 0);
-        for (c, row) in cost.iter().enumerate().take(children.len()) {
-            if assigned[c] {
-                continue;
-            }
-            for (s, &k) in row.iter().enumerate() {
-                if slots[s].is_none() && (k < best.0 || best.0 == f32::INFINITY) {
-                    best = (k, c, s);
-                }
-            }
-        }
-        let (_, c, s) = best;
-        assigned[c] = true;
+        // The cheapest free pair (the first in (child, slot) order among equals): a
+        // minimum that vectorises, then its first position.
+        let min = cost.iter().fold(f32::INFINITY, |m, &k| m.min(k));
+        let i = cost.iter().position(|&k| k == min).unwrap_or(0);
+        let (c, s) = (i / 8, i % 8);
         slots[s] = Some(children[c]);
+        cost[8 * c..8 * c + 8].fill(f32::INFINITY);
+        for row in cost.chunks_exact_mut(8) {
+            row[s] = f32::INFINITY;
+        }
     }
     slots
 }
@@ -319,11 +328,13 @@ fn quantisation_frame(aabb: &Aabb) -> (Vec3A, [u8; 3], [f64; 3]) {
             -126
         };
         exponent = exponent.clamp(-126, 127);
-        while exponent < 127 && 255.0 * f64::powi(2.0, exponent) < extent {
+        // 2^x exactly, from its bits (x is within f64's normal range).
+        let pow2 = |x: i32| f64::from_bits(((x + 1023) as u64) << 52);
+        while exponent < 127 && 255.0 * pow2(exponent) < extent {
             exponent += 1;
         }
         bytes[k] = (exponent + 127) as u8;
-        e[k] = f64::powi(2.0, exponent);
+        e[k] = pow2(exponent);
     }
     (p, bytes, e)
 }

@@ -86,34 +86,61 @@ pub struct TriangleRay {
 
 impl TriangleRay {
     /// `d` must be non-zero and finite.
-    #[inline]
+    #[inline(always)]
     pub fn new(o: Vec3, d: Vec3) -> Self {
-        // Written with array lookups and selects rather than branches: ray directions are
-        // random, branches on them mispredict.
-        const NEXT: [usize; 3] = [1, 2, 0];
-        let (oa, da) = (o.to_array(), d.to_array());
-        let a = d.abs().to_array();
-        let mut kz = if a[1] > a[0] { 1 } else { 0 };
-        kz = if a[2] > a[kz] { 2 } else { kz };
-        let (mut kx, mut ky) = (NEXT[kz], NEXT[NEXT[kz]]);
-        if da[kz] < 0.0 {
-            std::mem::swap(&mut kx, &mut ky);
-        }
-        let sz = 1.0 / da[kz];
+        // Branch-free, and without indexing arrays on the stack (a store and a reload per
+        // lookup): ray directions are random, branches on them mispredict.
+        let a = d.abs();
+        // kz = index of the largest |d| component (the first of equals, as a scan would),
+        // in integer arithmetic (compilers turn selects on it into branches).
+        let z_largest = (a.z > a.x.max(a.y)) as usize;
+        let kz = 2 * z_largest + (1 - z_largest) * (a.y > a.x) as usize;
+        let kx0 = [1, 2, 0][kz];
+        let ky0 = [2, 0, 1][kz];
+        // A negative d[kz] swaps x and y to keep the winding.
+        let negative = (d.cmplt(Vec3::ZERO).bitmask() as usize >> kz) & 1;
+        let swap = (kx0 ^ ky0) & negative.wrapping_neg();
+        let (kx, ky) = (kx0 ^ swap, ky0 ^ swap);
+        let (op, dp) = permute(o, d, [kx, ky, kz]);
+        let sz = 1.0 / dp.z;
         TriangleRay {
             kx,
             ky,
             kz,
-            ox: oa[kx],
-            oy: oa[ky],
-            oz: oa[kz],
-            sx: da[kx] * sz,
-            sy: da[ky] * sz,
+            ox: op.x,
+            oy: op.y,
+            oz: op.z,
+            sx: dp.x * sz,
+            sy: dp.y * sz,
             sz,
             o,
             d,
         }
     }
+}
+
+/// (o, d) with their components reordered as (k[0], k[1], k[2]) (each k < 3).
+#[cfg(all(target_arch = "x86_64", target_feature = "avx"))]
+#[inline(always)]
+fn permute(o: Vec3, d: Vec3, k: [usize; 3]) -> (Vec3, Vec3) {
+    use std::arch::x86_64::*;
+    // SAFETY: AVX is enabled for this build (cfg above); register operations only.
+    unsafe {
+        let idx = _mm_setr_epi32(k[0] as i32, k[1] as i32, k[2] as i32, 2);
+        let op = _mm_permutevar_ps(glam::Vec3A::from(o).into(), idx);
+        let dp = _mm_permutevar_ps(glam::Vec3A::from(d).into(), idx);
+        (glam::Vec3A::from(op).into(), glam::Vec3A::from(dp).into())
+    }
+}
+
+#[cfg(not(all(target_arch = "x86_64", target_feature = "avx")))]
+#[inline(always)]
+fn permute(o: Vec3, d: Vec3, k: [usize; 3]) -> (Vec3, Vec3) {
+    let (oa, da) = (o.to_array(), d.to_array());
+    (
+        Vec3::new(oa[k[0]], oa[k[1]], oa[k[2]]),
+        Vec3::new(da[k[0]], da[k[1]], da[k[2]]),
+    )
 }
 
 /// What the test found: the edge functions (proportional to the barycentrics of vertices
@@ -138,7 +165,8 @@ impl TriangleHit {
 /// In f64 from the f32 inputs: the differences are exact, the cross product rounds once,
 /// the dot products a few times, all relative to ~2⁻⁵², so the sign is wrong only for an
 /// origin within ~1e-15·|v0 − o| of the plane (spawned origins sit ~1e-7 away).
-#[inline(never)]
+/// Inlined: a call would spill every vector register the traversal keeps live.
+#[inline(always)]
 fn t_is_positive(tri: &TriangleRecord, r: &TriangleRay) -> bool {
     let v = [0, 1, 2].map(|i| tri.vertex(i).as_dvec3());
     let n = (v[1] - v[0]).cross(v[2] - v[0]);
