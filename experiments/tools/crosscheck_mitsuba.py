@@ -36,10 +36,11 @@ LLVM_HINT = (
     "llvm_ad_rgb needs a system libLLVM >= 16 (LLVM 15 aborts in the first render): "
     "`apt-get install libllvm19`, or point DRJIT_LIBLLVM_PATH at a libLLVM.so"
 )
-# Largest number of camera paths Mitsuba's vectorised variant renders in one launch; more
-# spp than this is rendered as several passes (different seeds) and averaged.
+# Most camera paths rendered in one launch of a vectorised variant (its wavefront holds all
+# of them in memory); a larger spp is rendered as several launches with different seeds,
+# averaged.
 MAX_LANES = 1 << 24
-# Suffix of `mltbench render`'s last report line (src/main.rs).
+# The summary line `mltbench render` writes to stderr (src/main.rs).
 MLTBENCH_LINE = re.compile(
     r"^(?P<est>\S+): (?P<passes>\d+) passes, (?P<samples>\d+) samples, (?P<secs>[0-9.]+) s "
     r"\((?P<msps>[0-9.]+) M samples/s[^)]*\)(, (?P<dropped>\d+) invalid samples dropped)?"
@@ -62,6 +63,7 @@ def worker(job_file):
 
     mi.set_variant(job["variant"])
     mi.set_log_level(mi.LogLevel.Warn)
+    # The pool's size counts the calling thread, which works too: T means T busy threads.
     dr.set_thread_count(job["threads"])
     scene_path = job["scene"]
     spps = job["spps"]
@@ -137,6 +139,7 @@ def run_mitsuba(args, variant, spps, outdir):
         "outdir": str(outdir),
         "result": str(outdir / f"mitsuba-{variant}.json"),
     }
+    Path(job["result"]).unlink(missing_ok=True)  # a --keep DIR may hold an older one
     job_file = outdir / f"job-{variant}.json"
     job_file.write_text(json.dumps(job))
     proc = subprocess.run(
@@ -521,8 +524,9 @@ def crosscheck(args, outdir):
     mlt = {spp: run_mltbench(args, spp, outdir) for spp in args.spps}
 
     any_m = next(iter(results.values()))
+    how_spp = "passed as $spp" if any_m["declares_spp"] else "set on render"
     print(f"scene     {args.scene} ({any_m['width']} x {any_m['height']}, "
-          f"{any_m['rfilter']}; spp {'passed as $spp' if any_m['declares_spp'] else 'set on render'})")
+          f"{any_m['rfilter']}; spp {how_spp})")
     print(f"mltbench  {args.mltbench} --estimator {args.estimator}, "
           f"{args.threads} threads, seed {args.seed}")
     if args.defines:
