@@ -270,7 +270,10 @@ pub fn report(
         experiment: experiment.name.clone(),
         description: experiment.description.clone(),
         scene: experiment.scene.display().to_string(),
-        budget: format!("{:?}", experiment.budget),
+        budget: match experiment.budget {
+            crate::render::Budget::Seconds(t) => format!("{t} s"),
+            crate::render::Budget::Passes(p) => format!("{p} passes"),
+        },
         checkpoints: experiment.checkpoints,
         runs: experiment.runs,
         reference: reference.path.display().to_string(),
