@@ -231,6 +231,29 @@ fn bad_specs_and_corrupt_results_are_errors_naming_the_file() {
         );
     }
 
+    // A parameter the estimator does not have: refused before anything renders.
+    let path = dir.join("bad_param.toml");
+    std::fs::write(
+        &path,
+        good.replace(
+            "[[estimator]]\nname = \"pt\"",
+            "[[estimator]]\nname = \"pt\"\nparams = { rr_dpeth = 3 }",
+        ),
+    )
+    .unwrap();
+    let exp = Experiment::load(&path, false).unwrap();
+    let err = experiment::run(&exp, &options(&dir.join("none")), &ProgressBar::hidden())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("bad_param.toml") && err.contains("rr_dpeth"),
+        "{err}"
+    );
+    assert!(
+        !dir.join("none/references").exists(),
+        "nothing was rendered"
+    );
+
     // A corrupt cell file in the results: an error naming it, not a panic.
     let spec = tiny_spec(&dir, "{ passes = 4 }");
     let exp = Experiment::load(&spec, false).unwrap();

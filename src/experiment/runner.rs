@@ -173,12 +173,34 @@ impl ResultsDir {
     }
 }
 
-/// Loads the experiment's scene with its parameters.
+/// Loads the experiment's scene with its parameters, and checks that every estimator (and
+/// the reference's) accepts its parameters, so that a misspelt one fails before any
+/// rendering rather than after the reference.
 pub fn load_scene(experiment: &Experiment) -> Result<Scene> {
-    Scene::build(mitsuba::load_file_with(
+    let scene = Scene::build(mitsuba::load_file_with(
         &experiment.scene,
         &experiment.scene_params,
-    )?)
+    )?)?;
+    let mut entries: Vec<(&str, &[String])> = experiment
+        .estimators
+        .iter()
+        .map(|e| (e.name.as_str(), e.params.as_slice()))
+        .collect();
+    if let ReferenceSource::Render {
+        estimator, params, ..
+    } = &experiment.reference
+    {
+        entries.push((estimator.as_str(), params.as_slice()));
+    }
+    for (name, params) in entries {
+        estimator::create(name, &Params::parse(params)?, &scene, 0).map_err(|e| {
+            Error::input(
+                Location::file(&experiment.spec_path),
+                format!("estimator {name}: {e}"),
+            )
+        })?;
+    }
+    Ok(scene)
 }
 
 /// The experiment's reference: its file, or the cached render, rendering it if needed.
