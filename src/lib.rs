@@ -11,6 +11,7 @@ pub mod film;
 pub mod geometry;
 pub mod image;
 pub mod io;
+pub mod lecture;
 pub mod light;
 pub mod material;
 pub mod math;
