@@ -284,6 +284,19 @@ fn experiment_bar() -> ProgressBar {
 
 fn run_experiment(args: RunArgs) -> Result<()> {
     let path = experiment::find_experiment(&args.experiment)?;
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+    if let Some(kind) = mltbench::lecture::kind_of(&text) {
+        if args.cells || args.cell.is_some() || args.prepare || args.quick {
+            return Err(Error::usage(format!(
+                "{}: a \"{kind}\" experiment runs whole (no --quick, --cells, --cell, --prepare)",
+                path.display()
+            )));
+        }
+        let pool = thread_pool(args.threads)?;
+        let out = pool.install(|| mltbench::lecture::run(&kind, &path, &text, &args.results))?;
+        eprintln!("{kind}: results in {}", out.display());
+        return Ok(());
+    }
     let exp = Experiment::load(&path, args.quick)?;
     if args.cells {
         println!(

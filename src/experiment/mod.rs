@@ -80,9 +80,14 @@ pub fn list_experiments() -> Result<Vec<(String, String)>> {
             .and_then(|s| s.to_str())
             .unwrap_or("")
             .to_string();
-        let description = match Experiment::load(&path, false) {
-            Ok(e) => e.description.lines().next().unwrap_or("").to_string(),
-            Err(err) => format!("(cannot be read: {err})"),
+        let text = std::fs::read_to_string(&path).unwrap_or_default();
+        let description = if crate::lecture::kind_of(&text).is_some() {
+            crate::lecture::description_of(&text).unwrap_or_default()
+        } else {
+            match Experiment::load(&path, false) {
+                Ok(e) => e.description.lines().next().unwrap_or("").to_string(),
+                Err(err) => format!("(cannot be read: {err})"),
+            }
         };
         out.push((name, description));
     }
