@@ -88,10 +88,17 @@ pub fn ccvt(n: usize, seed: u64, m: usize) -> Ccvt {
     let mut sweeps = 0;
     let mut swaps = 0;
     let mut stable = false;
+    // A pair whose sites took part in no swap since it was last visited is in the state in
+    // which it made no swap then, and is skipped.
+    let mut changed_before = vec![true; n];
+    let mut changed = vec![false; n];
     while !stable && sweeps < MAX_SWEEPS {
         sweeps += 1;
         stable = true;
         for (i, j) in neighbour_pairs(&sites, radius) {
+            if !(changed_before[i] || changed_before[j] || changed[i] || changed[j]) {
+                continue;
+            }
             let (si, sj) = (sites[i], sites[j]);
             // Keys: how much closer each point would be to the other site.
             let fill = |keys: &mut Vec<(f64, u32)>, own: [f64; 2], other: [f64; 2], of: &[u32]| {
@@ -120,11 +127,18 @@ pub fn ccvt(n: usize, seed: u64, m: usize) -> Ccvt {
                 members[j][b] = x;
                 swaps += 1;
                 stable = false;
+                changed[i] = true;
+                changed[j] = true;
             }
         }
-        for (site, own) in sites.iter_mut().zip(&members) {
-            *site = centroid(&discrete, own, *site);
+        // Only regions that changed have a new centroid.
+        for ((site, own), &moved) in sites.iter_mut().zip(&members).zip(&changed) {
+            if moved {
+                *site = centroid(&discrete, own, *site);
+            }
         }
+        std::mem::swap(&mut changed_before, &mut changed);
+        changed.fill(false);
     }
     Ccvt {
         sites: sites
@@ -155,14 +169,13 @@ fn centroid(discrete: &[[f64; 2]], own: &[u32], near: [f64; 2]) -> [f64; 2] {
 /// Pairs (i, j), i < j, of sites closer than `radius` on the torus, found with a grid of
 /// cells of side ≥ radius (all pairs when fewer than 3 cells fit per side).
 fn neighbour_pairs(sites: &[[f64; 2]], radius: f64) -> Vec<(usize, usize)> {
-    let n = sites.len();
     let g = (1.0 / radius).floor() as usize;
     let r2 = radius * radius;
     let mut pairs = Vec::new();
     if g < 3 {
-        for i in 0..n {
-            for j in i + 1..n {
-                if dist2(sites[i], sites[j]) < r2 {
+        for (i, &a) in sites.iter().enumerate() {
+            for (j, &b) in sites.iter().enumerate().skip(i + 1) {
+                if dist2(a, b) < r2 {
                     pairs.push((i, j));
                 }
             }
