@@ -53,12 +53,20 @@ fn every_pattern_lies_in_the_unit_square_and_is_deterministic() {
                 for p in &a {
                     assert!(in_unit_square(*p), "{pattern} n={n} seed={seed}: {p}");
                 }
-                assert_eq!(a, points(pattern, n, seed), "{pattern} n={n} not deterministic");
+                assert_eq!(
+                    a,
+                    points(pattern, n, seed),
+                    "{pattern} n={n} not deterministic"
+                );
             }
             // Seeds matter, except for a pure grid.
             let random = !(pattern == Pattern::Regular && grid_side(n).pow(2) == n);
             if random && n >= 2 {
-                assert_ne!(points(pattern, n, 1), points(pattern, n, 2), "{pattern} n={n}");
+                assert_ne!(
+                    points(pattern, n, 1),
+                    points(pattern, n, 2),
+                    "{pattern} n={n}"
+                );
             }
         }
     }
@@ -206,7 +214,10 @@ fn sobol_power_of_two_prefixes_are_02_nets() {
     // The scramble moves points, differently for each seed.
     let plain = sobol::unscrambled_points(256);
     assert_ne!(points(Pattern::Sobol, 256, 0), plain);
-    assert_ne!(points(Pattern::Sobol, 256, 0), points(Pattern::Sobol, 256, 1));
+    assert_ne!(
+        points(Pattern::Sobol, 256, 0),
+        points(Pattern::Sobol, 256, 1)
+    );
 }
 
 #[test]

@@ -13,12 +13,13 @@
 //!
 //! Distances are toroidal, so the point set tiles the plane. Only pairs of sites closer than
 //! `NEIGHBOUR_RADIUS`/√N are visited: the regions of farther sites do not touch once the
-//! initial assignment is spatially coherent. That assignment cuts the Hilbert-curve order of
-//! the discrete points into N runs of m, and the initial sites are the runs' centroids.
+//! initial assignment is spatially coherent: sites start uniform random, and both the sites
+//! and the discrete points are ordered along a Hilbert curve, the discrete points cut into N
+//! runs of m, run s assigned to site s.
 
 use glam::Vec2;
 
-use super::pattern::{Pattern, pattern_rng, wrap_unit};
+use super::pattern::{Pattern, pattern_rng, uniform_f64, wrap_unit};
 use super::stratified;
 
 /// Discrete points per site (the paper's M/N); capacities are all equal to it.
@@ -73,13 +74,18 @@ pub fn ccvt(n: usize, seed: u64, m: usize) -> Ccvt {
     }
     let mut rng = pattern_rng(seed, n, Pattern::Ccvt);
     let mut discrete = stratified::points_f64(n * m, &mut rng);
-    // Initial assignment: N runs of m consecutive points along a Hilbert curve.
+    // Initial sites: uniform random, as in the paper. Initial assignment: the discrete points
+    // in Hilbert-curve order cut into N runs of m, run s to the site of Hilbert rank s, so
+    // that a site's points start near it and swaps between neighbours can finish the job.
+    // (Runs' centroids would be a poor start: for N a power of 4 they form a square grid,
+    // which is already stable.)
+    let mut sites: Vec<[f64; 2]> = (0..n)
+        .map(|_| [uniform_f64(&mut rng), uniform_f64(&mut rng)])
+        .collect();
     discrete.sort_by_cached_key(|p| hilbert_index(p[0], p[1]));
+    sites.sort_by_cached_key(|p| hilbert_index(p[0], p[1]));
     let mut members: Vec<Vec<u32>> = (0..n)
         .map(|s| ((s * m) as u32..((s + 1) * m) as u32).collect())
-        .collect();
-    let mut sites: Vec<[f64; 2]> = (0..n)
-        .map(|s| centroid(&discrete, &members[s], discrete[members[s][0] as usize]))
         .collect();
 
     let radius = (NEIGHBOUR_RADIUS / (n as f64).sqrt()).min(1.0);

@@ -34,7 +34,10 @@ pub(crate) fn points_f64(n: usize, rng: &mut IndependentSampler) -> Vec<[f64; 2]
         for i in 0..k {
             let x = (i as f64 + uniform_f64(rng)) / k as f64;
             let y = (j as f64 + uniform_f64(rng)) / k as f64;
-            points.push([x.min(1.0 - f64::EPSILON / 2.0), y.min(1.0 - f64::EPSILON / 2.0)]);
+            points.push([
+                x.min(1.0 - f64::EPSILON / 2.0),
+                y.min(1.0 - f64::EPSILON / 2.0),
+            ]);
         }
     }
     points.extend((k * k..n).map(|_| [uniform_f64(rng), uniform_f64(rng)]));
