@@ -7,6 +7,7 @@ use std::time::Instant;
 use glam::Vec2;
 use mltbench::sampler::pattern::{
     Pattern, cell_index, grid_side, max_packing_radius, min_toroidal_distance, points,
+    toroidal_distance,
 };
 use mltbench::sampler::{ccvt, poisson, sobol};
 use statrs::distribution::{ChiSquared, ContinuousCDF};
@@ -165,6 +166,23 @@ fn poisson_disk_respects_its_radius_and_fills_the_square() {
     }
 }
 
+/// The mean over points of the toroidal distance to the nearest other point.
+fn mean_nearest_neighbour(points: &[Vec2]) -> f64 {
+    let sum: f64 = points
+        .iter()
+        .enumerate()
+        .map(|(i, &a)| {
+            points
+                .iter()
+                .enumerate()
+                .filter(|&(j, _)| j != i)
+                .map(|(_, &b)| toroidal_distance(a, b))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .sum();
+    sum / points.len() as f64
+}
+
 #[test]
 fn ccvt_is_well_spread_with_equal_capacities() {
     for (n, seed) in [(64, 1), (256, 2), (1000, 3), (1024, 4)] {
@@ -172,8 +190,9 @@ fn ccvt_is_well_spread_with_equal_capacities() {
         let run = ccvt::ccvt(n, seed, ccvt::POINTS_PER_SITE);
         let elapsed = t.elapsed();
         let rel = min_toroidal_distance(&run.sites) / max_packing_radius(n);
+        let mean_nn = mean_nearest_neighbour(&run.sites) / max_packing_radius(n);
         eprintln!(
-            "ccvt n={n}: {} sweeps, {} swaps, stable {}, min distance {rel:.3} of r_max, {elapsed:.2?}",
+            "ccvt n={n}: {} sweeps, {} swaps, stable {}, min distance {rel:.3} and mean nearest neighbour {mean_nn:.3} of r_max, {elapsed:.2?}",
             run.sweeps, run.swaps, run.stable
         );
         assert!(run.stable, "ccvt n={n}: did not converge");
@@ -184,6 +203,11 @@ fn ccvt_is_well_spread_with_equal_capacities() {
             "ccvt n={n}: unequal capacities"
         );
         assert!(rel >= 0.5, "ccvt n={n}: min distance {rel} of r_max");
+        // Uniform random points average about 0.47 of r_max.
+        assert!(
+            mean_nn >= 0.75,
+            "ccvt n={n}: mean nearest neighbour {mean_nn} of r_max"
+        );
     }
 }
 
