@@ -4,7 +4,13 @@
 //! sample pattern (or PSSMLT's mutating primary-sample sampler) can be swapped in without
 //! touching the estimator.
 
+pub mod ccvt;
 pub mod independent;
+pub mod pattern;
+pub mod poisson;
+pub mod regular;
+pub mod sobol;
+pub mod stratified;
 
 pub use independent::IndependentSampler;
 
