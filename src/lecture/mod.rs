@@ -4,6 +4,7 @@
 
 pub mod mc_basics;
 pub mod mc_basics_report;
+pub mod sampling_rates;
 
 use std::path::{Path, PathBuf};
 
@@ -31,10 +32,11 @@ pub fn run(kind: &str, spec_path: &Path, text: &str, results_root: &Path) -> Res
     let out = results_root.join(name);
     match kind {
         "mc-basics" => mc_basics_report::run(spec_path, text, &out)?,
+        "sampling-rates" => sampling_rates::run(spec_path, text, &out)?,
         other => {
             return Err(Error::input(
                 Location::file(spec_path),
-                format!("unknown experiment kind \"{other}\" (known: mc-basics)"),
+                format!("unknown experiment kind \"{other}\" (known: mc-basics, sampling-rates)"),
             ));
         }
     }
