@@ -12,10 +12,15 @@
 //! centroids of their capacity-constrained regions.
 //!
 //! Distances are toroidal, so the point set tiles the plane. Only pairs of sites closer than
-//! `NEIGHBOUR_RADIUS`/√N are visited: the regions of farther sites do not touch once the
-//! initial assignment is spatially coherent: sites start uniform random, and both the sites
-//! and the discrete points are ordered along a Hilbert curve, the discrete points cut into N
-//! runs of m, run s assigned to site s.
+//! `NEIGHBOUR_RADIUS`/√N are visited, which relies on a spatially coherent initial
+//! assignment: sites start uniform random, and both the sites and the discrete points are
+//! ordered along a Hilbert curve, the discrete points cut into N runs of m, run s assigned
+//! to site s. (Checked: visiting all pairs instead gives the same minimum and mean
+//! nearest-neighbour distances at N = 256 and 1024, about 18 times slower at 1024.)
+//!
+//! m trades time for quality: at N = 256, m = 64 gives a minimum distance of about 0.61–0.67
+//! and a mean nearest-neighbour distance of 0.81 of the packing spacing; m = 512 gives
+//! 0.71–0.74 and 0.85 in 20 times the time.
 
 use glam::Vec2;
 
