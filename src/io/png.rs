@@ -48,17 +48,31 @@ pub fn write_png_preview(path: &Path, image: &Image) -> Result<()> {
     for c in &mapped.pixels {
         bytes.extend(c.0.iter().map(|&v| srgb_to_u8(v)));
     }
+    write_rgb8_png(path, image.width, image.height, &bytes)
+}
+
+/// Writes 8-bit sRGB pixels (3 bytes each, row 0 at the top) as a PNG (atomically).
+pub fn write_rgb8_png(path: &Path, width: u32, height: u32, bytes: &[u8]) -> Result<()> {
+    if width == 0 || height == 0 || bytes.len() != 3 * width as usize * height as usize {
+        return Err(Error::input(
+            Location::file(path),
+            format!(
+                "cannot write {} bytes as a {width}×{height} RGB PNG",
+                bytes.len()
+            ),
+        ));
+    }
     let png_error = |e: png::EncodingError| match e {
         png::EncodingError::IoError(io) => Error::io(path, io),
         other => Error::input(Location::file(path), format!("cannot write PNG: {other}")),
     };
     write_atomically(path, |writer| {
-        let mut encoder = png::Encoder::new(writer, image.width, image.height);
+        let mut encoder = png::Encoder::new(writer, width, height);
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
         let mut png_writer = encoder.write_header().map_err(png_error)?;
-        png_writer.write_image_data(&bytes).map_err(png_error)?;
+        png_writer.write_image_data(bytes).map_err(png_error)?;
         png_writer.finish().map_err(png_error)
     })
 }

@@ -5,6 +5,7 @@
 pub mod mc_basics;
 pub mod mc_basics_report;
 pub mod sampling_rates;
+pub mod sampling_spectra;
 
 use std::path::{Path, PathBuf};
 
@@ -33,10 +34,13 @@ pub fn run(kind: &str, spec_path: &Path, text: &str, results_root: &Path) -> Res
     match kind {
         "mc-basics" => mc_basics_report::run(spec_path, text, &out)?,
         "sampling-rates" => sampling_rates::run(spec_path, text, &out)?,
+        "sampling-spectra" => sampling_spectra::run(spec_path, text, &out)?,
         other => {
             return Err(Error::input(
                 Location::file(spec_path),
-                format!("unknown experiment kind \"{other}\" (known: mc-basics, sampling-rates)"),
+                format!(
+                    "unknown experiment kind \"{other}\" (known: mc-basics, sampling-rates, sampling-spectra)"
+                ),
             ));
         }
     }
