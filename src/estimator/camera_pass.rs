@@ -12,6 +12,7 @@ use crate::film::{Film, FilmTile};
 use crate::geometry::Ray;
 use crate::image::Image;
 use crate::math::Rgb;
+use crate::sampler::pixel_samples::PixelSamples;
 use crate::sampler::{IndependentSampler, Sampler};
 use crate::scene::Scene;
 
@@ -39,6 +40,7 @@ pub fn camera_pass(
     film: &mut Film,
     seed: u64,
     pass_index: u32,
+    pixel_samples: &PixelSamples,
     estimate: &impl CameraSampleFn,
 ) -> PassCounts {
     let rects = film.tiles(TILE_SIZE);
@@ -51,7 +53,10 @@ pub fn camera_pass(
             for y in rect.y0..rect.y1 {
                 for x in rect.x0..rect.x1 {
                     sampler.start_pixel_sample((x, y), pass_index as u64);
-                    let raster = raster_in_pixel(x, y, sampler.next_2d());
+                    let offset = pixel_samples
+                        .offset(seed, (x, y), pass_index as u64)
+                        .unwrap_or_else(|| sampler.next_2d());
+                    let raster = raster_in_pixel(x, y, offset);
                     let ray = scene.camera.generate_ray(raster);
                     let (value, rays) = estimate.radiance(scene, &ray, &mut sampler);
                     counts.samples += 1;
@@ -84,6 +89,7 @@ pub struct CameraEstimator<S> {
     seed: u64,
     stats: Stats,
     sample: S,
+    pixel_samples: PixelSamples,
 }
 
 impl<S: CameraSampleFn + Send> CameraEstimator<S> {
@@ -95,7 +101,14 @@ impl<S: CameraSampleFn + Send> CameraEstimator<S> {
             seed,
             stats: Stats::default(),
             sample,
+            pixel_samples: PixelSamples::Independent,
         }
+    }
+
+    /// Places the camera samples inside their pixels with `pixel_samples`.
+    pub fn with_pixel_samples(mut self, pixel_samples: PixelSamples) -> Self {
+        self.pixel_samples = pixel_samples;
+        self
     }
 
     /// The per-sample computation (its settings).
@@ -110,7 +123,14 @@ impl<S: CameraSampleFn + Send> Estimator for CameraEstimator<S> {
     }
 
     fn run_pass(&mut self, scene: &Scene, pass_index: u32) {
-        let counts = camera_pass(scene, &mut self.film, self.seed, pass_index, &self.sample);
+        let counts = camera_pass(
+            scene,
+            &mut self.film,
+            self.seed,
+            pass_index,
+            &self.pixel_samples,
+            &self.sample,
+        );
         self.stats.passes += 1;
         self.stats.samples += counts.samples;
         self.stats.rays += counts.rays;

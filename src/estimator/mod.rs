@@ -14,6 +14,8 @@ pub use params::Params;
 
 use crate::error::{Error, Result};
 use crate::image::Image;
+use crate::sampler::pattern::Pattern;
+use crate::sampler::pixel_samples::PixelSamples;
 use crate::scene::Scene;
 
 /// Counters an estimator reports; experiments read them to normalise by work done.
@@ -45,12 +47,13 @@ pub const ESTIMATOR_NAMES: &[&str] = &["pt", "eyelight"];
 /// Fails on an unknown name or a parameter the estimator does not have.
 pub fn create(name: &str, params: &Params, scene: &Scene, seed: u64) -> Result<Box<dyn Estimator>> {
     let estimator: Box<dyn Estimator> = match name {
-        "eyelight" => Box::new(eyelight::new(scene, seed)),
-        "pt" => Box::new(pt::new(
-            scene,
-            seed,
-            pt::PtSettings::from_params(params, scene)?,
-        )),
+        "eyelight" => Box::new(
+            eyelight::new(scene, seed).with_pixel_samples(pixel_samples(params, scene, seed)?),
+        ),
+        "pt" => Box::new(
+            pt::new(scene, seed, pt::PtSettings::from_params(params, scene)?)
+                .with_pixel_samples(pixel_samples(params, scene, seed)?),
+        ),
         _ => {
             return Err(Error::usage(format!(
                 "unknown estimator '{name}' (known: {})",
@@ -60,4 +63,22 @@ pub fn create(name: &str, params: &Params, scene: &Scene, seed: u64) -> Result<B
     };
     params.check_all_used(name)?;
     Ok(estimator)
+}
+
+/// The camera estimators' `sampler` (a `sampler::pattern::Pattern` name, default
+/// `independent`) and `sampler_size` (points in the pattern, default the scene's
+/// `<sampler sample_count>`: the spp the pattern is laid out for) parameters.
+fn pixel_samples(params: &Params, scene: &Scene, seed: u64) -> Result<PixelSamples> {
+    let name: String = params.get("sampler", "independent".to_string())?;
+    let pattern: Pattern = name
+        .parse()
+        .map_err(|e: String| Error::usage(format!("--set sampler={name}: {e}")))?;
+    let default_size = scene.description.sensor.sample_count.max(1) as usize;
+    let size: usize = params.get("sampler_size", default_size)?;
+    if size == 0 || size > 1 << 16 {
+        return Err(Error::usage(format!(
+            "--set sampler_size={size}: must be between 1 and 65536"
+        )));
+    }
+    Ok(PixelSamples::new(pattern, size, seed))
 }
