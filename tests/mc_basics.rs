@@ -146,3 +146,31 @@ fn control_variates_with_the_optimal_beta_beat_beta_one() {
     }
     assert!(optimal.sample_variance < one.sample_variance / 5.0);
 }
+
+#[test]
+fn the_4d_example_matches_its_1d_reduction() {
+    let truth = cos50_4d_integral();
+    // Cross-check the reduction with a 4D midpoint rule (24⁴ points; the integrand is smooth).
+    let k = 24;
+    let mut sum = 0.0;
+    for a in 0..k {
+        for b in 0..k {
+            for c in 0..k {
+                for d in 0..k {
+                    let m = |i: usize| (i as f64 + 0.5) / k as f64;
+                    sum += (m(a) * m(b) * m(c) * m(d)).cos().powi(50);
+                }
+            }
+        }
+    }
+    let midpoint = sum / (k as f64).powi(4);
+    assert!(
+        (midpoint - truth).abs() < 2e-3,
+        "midpoint {midpoint} vs {truth}"
+    );
+    check(
+        "cos^50(xyzw) over [0,1]^4",
+        cos50_4d_uniform(400_000, 12),
+        truth,
+    );
+}
