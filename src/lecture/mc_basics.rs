@@ -148,6 +148,23 @@ pub fn rejection_beta22(n: usize, seed: u64) -> (Estimate, Estimate) {
     )
 }
 
+/// The accepted samples of the rejection sampler of `rejection_beta22` (same seed, same
+/// samples).
+pub fn rejection_beta22_samples(n: usize, seed: u64) -> Vec<f64> {
+    const C: f64 = 1.5;
+    let mut r = rng(seed);
+    (0..n)
+        .map(|_| {
+            loop {
+                let x = r.random::<f64>();
+                if r.random::<f64>() * C <= 6.0 * x * (1.0 - x) {
+                    break x;
+                }
+            }
+        })
+        .collect()
+}
+
 /// Exponential variates of rate λ by inverse transform: x = −ln(1 − u)/λ.
 pub fn exponential_inverse_transform(n: usize, lambda: f64, seed: u64) -> Vec<f64> {
     let mut r = rng(seed);
