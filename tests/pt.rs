@@ -84,16 +84,24 @@ fn pixel_sees_only(scene: &Scene, x: u32, y: u32, shape: u32) -> bool {
         })
 }
 
-/// A camera at the origin looking down −z, 32×32 pixels, box filter.
-const CAMERA: &str = r#"
-    <sensor type="perspective">
-        <float name="fov" value="60"/>
-        <transform name="to_world"><lookat origin="0,0,0" target="0,0,-1" up="0,1,0"/></transform>
-        <film type="hdrfilm">
-            <integer name="width" value="32"/><integer name="height" value="32"/>
-            <rfilter type="box"/>
-        </film>
-    </sensor>"#;
+/// A perspective sensor with a box filter (pixels are then independent estimates).
+fn sensor(fov: f32, origin: &str, target: &str, res: u32) -> String {
+    format!(
+        r#"<sensor type="perspective">
+            <float name="fov" value="{fov}"/>
+            <transform name="to_world"><lookat origin="{origin}" target="{target}" up="0,1,0"/></transform>
+            <film type="hdrfilm">
+                <integer name="width" value="{res}"/><integer name="height" value="{res}"/>
+                <rfilter type="box"/>
+            </film>
+        </sensor>"#
+    )
+}
+
+/// A camera at the origin looking down −z, 32×32 pixels.
+fn camera() -> String {
+    sensor(60.0, "0,0,0", "0,0,-1", 32)
+}
 
 /// A closed enclosure around the camera, normals inward, emitting `le` with albedo `albedo`.
 fn enclosure(shape: &str, albedo: &str, le: &str) -> String {
@@ -115,11 +123,12 @@ fn furnace(shape: &str, albedo: &str, le: &str, max_depth: i32, inside: &str) ->
     scene(&format!(
         r#"<scene version="3.0.0">
             <integrator type="path"><integer name="max_depth" value="{max_depth}"/></integrator>
-            {CAMERA}
+            {camera}
             {}
             {inside}
         </scene>"#,
-        enclosure(shape, albedo, le)
+        enclosure(shape, albedo, le),
+        camera = camera()
     ))
 }
 
@@ -204,7 +213,7 @@ fn emitters_seen_directly_show_their_radiance_from_the_front_only() {
     // A black emitter facing the camera on the left, one facing away on the right.
     let scene = scene(&format!(
         r#"<scene version="3.0.0">
-            {CAMERA}
+            {camera}
             <bsdf type="diffuse" id="black"><rgb name="reflectance" value="0"/></bsdf>
             <shape type="rectangle">
                 <transform name="to_world"><translate x="-1.1" z="-2"/></transform>
@@ -218,7 +227,8 @@ fn emitters_seen_directly_show_their_radiance_from_the_front_only() {
             </shape>
             <emitter type="point"><point name="position" x="0" y="0" z="-1"/>
                 <rgb name="intensity" value="5"/></emitter>
-        </scene>"#
+        </scene>"#,
+        camera = camera()
     ));
     let image = render_pt(&scene, &[], 4, 1);
     let (mut front, mut back) = (0, 0);
@@ -243,15 +253,9 @@ fn emitters_seen_directly_show_their_radiance_from_the_front_only() {
 }
 
 /// A camera looking down at the floor y = −1 from under the Cornell box light, 16×16 pixels.
-const FLOOR_CAMERA: &str = r#"
-    <sensor type="perspective">
-        <float name="fov" value="28"/>
-        <transform name="to_world"><lookat origin="0,0.9,1.2" target="0,-1,-0.1" up="0,1,0"/></transform>
-        <film type="hdrfilm">
-            <integer name="width" value="16"/><integer name="height" value="16"/>
-            <rfilter type="box"/>
-        </film>
-    </sensor>"#;
+fn floor_camera() -> String {
+    sensor(28.0, "0,0.9,1.2", "0,-1,-0.1", 16)
+}
 
 /// Irradiance at `p` (normal `n`) from a uniform Lambertian polygon of unit radiance:
 /// Lambert's formula E = ½ Σ_i Θ_i (n · γ̂_i), Θ_i the angle the edge v_i v_{i+1} subtends
@@ -307,7 +311,7 @@ fn floor_irradiance_under_a_rectangle_light_matches_lamberts_formula() {
     let scene = scene(&format!(
         r#"<scene version="3.0.0">
             <integrator type="path"><integer name="max_depth" value="2"/></integrator>
-            {FLOOR_CAMERA}
+            {floor_camera}
             <shape type="rectangle">
                 <transform name="to_world">
                     <scale x="0.23" y="0.19"/><rotate x="1" angle="90"/><translate y="0.99"/>
@@ -319,7 +323,8 @@ fn floor_irradiance_under_a_rectangle_light_matches_lamberts_formula() {
                 <transform name="to_world"><rotate x="1" angle="-90"/><translate y="-1"/></transform>
                 <bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf>
             </shape>
-        </scene>"#
+        </scene>"#,
+        floor_camera = floor_camera()
     ));
     let light = [
         Vec3::new(-0.23, 0.99, -0.19),
@@ -350,14 +355,15 @@ fn floor_under_a_point_light_follows_the_inverse_square_law() {
     let (rho, intensity, light) = (0.5f64, 4.0f64, Vec3::new(0.3, 0.5, -0.2));
     let scene = scene(&format!(
         r#"<scene version="3.0.0">
-            {FLOOR_CAMERA}
+            {floor_camera}
             <emitter type="point"><point name="position" x="0.3" y="0.5" z="-0.2"/>
                 <rgb name="intensity" value="4"/></emitter>
             <shape type="rectangle">
                 <transform name="to_world"><rotate x="1" angle="-90"/><translate y="-1"/></transform>
                 <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf>
             </shape>
-        </scene>"#
+        </scene>"#,
+        floor_camera = floor_camera()
     ));
     let image = render_pt(&scene, &[], 4, 9);
     for (x, y) in [(8, 8), (2, 3), (14, 12)] {
@@ -382,11 +388,12 @@ fn uniform_environment_lights_a_convex_diffuse_object_to_its_albedo() {
     let sphere = |bsdf: &str| {
         scene(&format!(
             r#"<scene version="3.0.0">
-                {CAMERA}
+                {camera}
                 <emitter type="constant"><rgb name="radiance" value="1.5"/></emitter>
                 <shape type="sphere"><point name="center" x="0.3" y="0" z="-3"/>
                     <float name="radius" value="1"/>{bsdf}</shape>
-            </scene>"#
+            </scene>"#,
+            camera = camera()
         ))
     };
     let diffuse =
