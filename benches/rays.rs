@@ -176,5 +176,11 @@ fn bench_rays(c: &mut Criterion) {
     }
 }
 
-criterion_group!(benches, bench_rays);
+criterion_group! {
+    name = benches;
+    // No HTML plots: mltbench builds plotters without system-font lookup (its plots embed a
+    // font), and criterion's report plots would need one.
+    config = Criterion::default().without_plots();
+    targets = bench_rays
+}
 criterion_main!(benches);
