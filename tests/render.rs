@@ -247,7 +247,7 @@ impl mltbench::estimator::camera_pass::CameraSampleFn for Poisoned {
         &self,
         _: &Scene,
         ray: &mltbench::geometry::Ray,
-        _: &mut mltbench::sampler::IndependentSampler,
+        _: &mut mltbench::sampler::pixel_samples::CameraSampler,
     ) -> (mltbench::math::Rgb, u64) {
         use mltbench::math::Rgb;
         // The camera sits on the z axis: the sign pattern of the direction picks a case.

@@ -12,8 +12,10 @@ use crate::film::{Film, FilmTile};
 use crate::geometry::Ray;
 use crate::image::Image;
 use crate::math::Rgb;
-use crate::sampler::pixel_samples::PixelSamples;
-use crate::sampler::{IndependentSampler, Sampler};
+use std::sync::Arc;
+
+use crate::sampler::Sampler;
+use crate::sampler::pixel_samples::{CameraSampler, PixelSamples};
 use crate::scene::Scene;
 
 /// Edge length of a tile in pixels.
@@ -30,7 +32,7 @@ pub struct PassCounts {
 /// What an estimator computes for one camera sample: the radiance along `ray`,
 /// and the number of rays it cast.
 pub trait CameraSampleFn: Sync {
-    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut IndependentSampler) -> (Rgb, u64);
+    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut CameraSampler) -> (Rgb, u64);
 }
 
 /// Takes sample number `pass_index` of every pixel and adds it to `film`.
@@ -40,7 +42,7 @@ pub fn camera_pass(
     film: &mut Film,
     seed: u64,
     pass_index: u32,
-    pixel_samples: &PixelSamples,
+    pixel_samples: &Arc<PixelSamples>,
     estimate: &impl CameraSampleFn,
 ) -> PassCounts {
     let rects = film.tiles(TILE_SIZE);
@@ -49,14 +51,11 @@ pub fn camera_pass(
         .map(|&rect| {
             let mut tile = film.tile(rect);
             let mut counts = PassCounts::default();
-            let mut sampler = IndependentSampler::new(seed);
+            let mut sampler = CameraSampler::new(seed, pixel_samples.clone());
             for y in rect.y0..rect.y1 {
                 for x in rect.x0..rect.x1 {
                     sampler.start_pixel_sample((x, y), pass_index as u64);
-                    let offset = pixel_samples
-                        .offset(seed, (x, y), pass_index as u64)
-                        .unwrap_or_else(|| sampler.next_2d());
-                    let raster = raster_in_pixel(x, y, offset);
+                    let raster = raster_in_pixel(x, y, sampler.next_2d());
                     let ray = scene.camera.generate_ray(raster);
                     let (value, rays) = estimate.radiance(scene, &ray, &mut sampler);
                     counts.samples += 1;
@@ -89,7 +88,7 @@ pub struct CameraEstimator<S> {
     seed: u64,
     stats: Stats,
     sample: S,
-    pixel_samples: PixelSamples,
+    pixel_samples: Arc<PixelSamples>,
 }
 
 impl<S: CameraSampleFn + Send> CameraEstimator<S> {
@@ -101,13 +100,13 @@ impl<S: CameraSampleFn + Send> CameraEstimator<S> {
             seed,
             stats: Stats::default(),
             sample,
-            pixel_samples: PixelSamples::Independent,
+            pixel_samples: Arc::new(PixelSamples::Independent),
         }
     }
 
     /// Places the camera samples inside their pixels with `pixel_samples`.
     pub fn with_pixel_samples(mut self, pixel_samples: PixelSamples) -> Self {
-        self.pixel_samples = pixel_samples;
+        self.pixel_samples = Arc::new(pixel_samples);
         self
     }
 

@@ -6,7 +6,7 @@
 use super::camera_pass::{CameraEstimator, CameraSampleFn};
 use crate::geometry::Ray;
 use crate::math::Rgb;
-use crate::sampler::IndependentSampler;
+use crate::sampler::pixel_samples::CameraSampler;
 use crate::scene::{BsdfDesc, EmitterDesc, Scene};
 
 /// How many `null` surfaces a preview ray may cross before giving up.
@@ -35,7 +35,7 @@ pub struct Shade {
 }
 
 impl CameraSampleFn for Shade {
-    fn radiance(&self, scene: &Scene, ray: &Ray, _: &mut IndependentSampler) -> (Rgb, u64) {
+    fn radiance(&self, scene: &Scene, ray: &Ray, _: &mut CameraSampler) -> (Rgb, u64) {
         let mut ray = *ray;
         for crossing in 0..=MAX_NULL_CROSSINGS {
             let Some(hit) = scene.geometry.intersect(&ray) else {

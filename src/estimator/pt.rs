@@ -29,7 +29,8 @@ use crate::light::LightPoint;
 use crate::material::{Bsdf, TransportMode};
 use crate::math::Rgb;
 use crate::path::mis::power_heuristic;
-use crate::sampler::{IndependentSampler, Sampler};
+use crate::sampler::Sampler;
+use crate::sampler::pixel_samples::CameraSampler;
 use crate::scene::Scene;
 
 /// `pt`'s settings (`--set key=value`; defaults from the scene's `<integrator>`).
@@ -110,7 +111,7 @@ impl PathSample {
         si: &SurfaceInteraction,
         bsdf: &Bsdf,
         wo: Vec3,
-        sampler: &mut IndependentSampler,
+        sampler: &mut CameraSampler,
     ) -> (Rgb, u64) {
         let u_light = sampler.next_1d();
         let u = sampler.next_2d();
@@ -144,7 +145,7 @@ impl PathSample {
 }
 
 impl CameraSampleFn for PathSample {
-    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut IndependentSampler) -> (Rgb, u64) {
+    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut CameraSampler) -> (Rgb, u64) {
         let max_depth = self.settings.max_depth.unwrap_or(u32::MAX);
         if max_depth == 0 {
             return (Rgb::BLACK, 0);

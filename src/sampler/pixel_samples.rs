@@ -2,6 +2,10 @@
 //! of a 2D pattern (`sampler::pattern`), so that the pixel integral is estimated with
 //! stratified, blue-noise or low-discrepancy points (`--set sampler=NAME`).
 //!
+//! `CameraSampler` is the `Sampler` camera estimators draw from: the first 2D sample of each
+//! pixel sample (the position in the pixel) comes from the pattern, every other number from
+//! the independent stream.
+//!
 //! A pattern of M points is generated once and shared by all pixels; each pixel applies its
 //! own random toroidal shift (a Cranley–Patterson rotation, Cranley & Patterson 1976) and
 //! starts at its own random index, so pixels are independent of each other while the
@@ -9,9 +13,12 @@
 //! (start + i) mod M: the first M samples of a pixel are exactly the (shifted) pattern, which
 //! is why M should equal the samples per pixel the render will take.
 
+use std::sync::Arc;
+
 use glam::Vec2;
 
-use super::independent::hash_words;
+use super::Sampler;
+use super::independent::{IndependentSampler, hash_words};
 use super::pattern::{Pattern, points};
 
 /// Tag that keeps the per-pixel shift independent of every other stream of the seed.
@@ -59,5 +66,41 @@ impl PixelSamples {
             if f >= 1.0 { 0.0 } else { f }
         };
         Some(Vec2::new(wrap(p.x), wrap(p.y)))
+    }
+}
+
+/// The sampler of camera estimators: an `IndependentSampler` whose first 2D sample in each
+/// pixel sample is the pixel position from `PixelSamples`.
+pub struct CameraSampler {
+    rng: IndependentSampler,
+    seed: u64,
+    pixel_samples: Arc<PixelSamples>,
+    /// The pattern's position for the current pixel sample, until `next_2d` hands it out.
+    pending: Option<Vec2>,
+}
+
+impl CameraSampler {
+    pub fn new(seed: u64, pixel_samples: Arc<PixelSamples>) -> CameraSampler {
+        CameraSampler {
+            rng: IndependentSampler::new(seed),
+            seed,
+            pixel_samples,
+            pending: None,
+        }
+    }
+}
+
+impl Sampler for CameraSampler {
+    fn start_pixel_sample(&mut self, pixel: (u32, u32), sample_index: u64) {
+        self.rng.start_pixel_sample(pixel, sample_index);
+        self.pending = self.pixel_samples.offset(self.seed, pixel, sample_index);
+    }
+
+    fn next_1d(&mut self) -> f32 {
+        self.rng.next_1d()
+    }
+
+    fn next_2d(&mut self) -> Vec2 {
+        self.pending.take().unwrap_or_else(|| self.rng.next_2d())
     }
 }
