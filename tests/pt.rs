@@ -252,6 +252,16 @@ fn emitters_seen_directly_show_their_radiance_from_the_front_only() {
     );
 }
 
+/// The Cornell box's floor (y = −1, [−1, 1]² in x and z), diffuse with `reflectance`.
+fn floor(reflectance: f64) -> String {
+    format!(
+        r#"<shape type="rectangle">
+            <transform name="to_world"><rotate x="1" angle="-90"/><translate y="-1"/></transform>
+            <bsdf type="diffuse"><rgb name="reflectance" value="{reflectance}"/></bsdf>
+        </shape>"#
+    )
+}
+
 /// A camera looking down at the floor y = −1 from under the Cornell box light, 16×16 pixels.
 fn floor_camera() -> String {
     sensor(28.0, "0,0.9,1.2", "0,-1,-0.1", 16)
@@ -319,12 +329,10 @@ fn floor_irradiance_under_a_rectangle_light_matches_lamberts_formula() {
                 <bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>
                 <emitter type="area"><rgb name="radiance" value="18.387, 13.9873, 6.75357"/></emitter>
             </shape>
-            <shape type="rectangle">
-                <transform name="to_world"><rotate x="1" angle="-90"/><translate y="-1"/></transform>
-                <bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf>
-            </shape>
+            {floor}
         </scene>"#,
-        floor_camera = floor_camera()
+        floor_camera = floor_camera(),
+        floor = floor(0.6)
     ));
     let light = [
         Vec3::new(-0.23, 0.99, -0.19),
@@ -358,12 +366,10 @@ fn floor_under_a_point_light_follows_the_inverse_square_law() {
             {floor_camera}
             <emitter type="point"><point name="position" x="0.3" y="0.5" z="-0.2"/>
                 <rgb name="intensity" value="4"/></emitter>
-            <shape type="rectangle">
-                <transform name="to_world"><rotate x="1" angle="-90"/><translate y="-1"/></transform>
-                <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf>
-            </shape>
+            {floor}
         </scene>"#,
-        floor_camera = floor_camera()
+        floor_camera = floor_camera(),
+        floor = floor(0.5)
     ));
     let image = render_pt(&scene, &[], 4, 9);
     for (x, y) in [(8, 8), (2, 3), (14, 12)] {

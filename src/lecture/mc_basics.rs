@@ -122,47 +122,38 @@ pub fn cos50_gaussian(n: usize, sigma: f64, seed: u64) -> Estimate {
     }))
 }
 
+/// Bound of the rejection sampler: 6x(1 − x) ≤ c·1 on [0, 1] with c = 1.5.
+const REJECTION_C: f64 = 1.5;
+
+/// One sample of the density 6x(1 − x) by rejection under c·U(0, 1): (sample, proposals).
+fn rejection_beta22_draw(r: &mut Xoshiro256PlusPlus) -> (f64, u32) {
+    let mut proposals = 0u32;
+    loop {
+        proposals += 1;
+        let x = r.random::<f64>();
+        if r.random::<f64>() * REJECTION_C <= 6.0 * x * (1.0 - x) {
+            return (x, proposals);
+        }
+    }
+}
+
 /// Rejection sampling of the density 6x(1 − x) on [0, 1] under the bound c·U(0,1), c = 1.5:
 /// returns the mean number of proposals per accepted sample (expected: c) and the accepted
 /// samples' mean (expected: 1/2).
 pub fn rejection_beta22(n: usize, seed: u64) -> (Estimate, Estimate) {
-    const C: f64 = 1.5;
     let mut r = rng(seed);
-    let mut iterations = Vec::with_capacity(n);
-    let mut values = Vec::with_capacity(n);
-    for _ in 0..n {
-        let mut k = 0u32;
-        let x = loop {
-            k += 1;
-            let x = r.random::<f64>();
-            if r.random::<f64>() * C <= 6.0 * x * (1.0 - x) {
-                break x;
-            }
-        };
-        iterations.push(k as f64);
-        values.push(x);
-    }
+    let draws: Vec<(f64, u32)> = (0..n).map(|_| rejection_beta22_draw(&mut r)).collect();
     (
-        Estimate::from_samples(iterations.into_iter()),
-        Estimate::from_samples(values.into_iter()),
+        Estimate::from_samples(draws.iter().map(|&(_, k)| k as f64)),
+        Estimate::from_samples(draws.iter().map(|&(x, _)| x)),
     )
 }
 
 /// The accepted samples of the rejection sampler of `rejection_beta22` (same seed, same
 /// samples).
 pub fn rejection_beta22_samples(n: usize, seed: u64) -> Vec<f64> {
-    const C: f64 = 1.5;
     let mut r = rng(seed);
-    (0..n)
-        .map(|_| {
-            loop {
-                let x = r.random::<f64>();
-                if r.random::<f64>() * C <= 6.0 * x * (1.0 - x) {
-                    break x;
-                }
-            }
-        })
-        .collect()
+    (0..n).map(|_| rejection_beta22_draw(&mut r).0).collect()
 }
 
 /// Exponential variates of rate λ by inverse transform: x = −ln(1 − u)/λ.
