@@ -1,5 +1,6 @@
 //! Ray casting throughput: closest-hit queries (`Geometry::intersect`, full surface data)
-//! per second on one and two threads, coherent camera rays and incoherent rays, plus the
+//! per second on one and two threads, coherent camera rays and incoherent rays, one query
+//! per ray and as a stream (`Geometry::intersect_stream`, several traversals in flight), plus the
 //! any-hit query and the build time, on two scenes:
 //! 1. the Cornell box (556 units) with a ~100k-triangle UV sphere,
 //! 2. a smooth displaced sphere of ~1M triangles.
@@ -87,6 +88,18 @@ fn trace_all(pool: &rayon::ThreadPool, geometry: &Geometry, rays: &[Ray]) -> usi
     })
 }
 
+/// `trace_all` through `Geometry::intersect_stream` (several traversals in flight).
+fn trace_stream(pool: &rayon::ThreadPool, geometry: &Geometry, rays: &[Ray]) -> usize {
+    pool.install(|| {
+        rays.par_chunks(CHUNK)
+            .map_init(Vec::new, |out, chunk| {
+                geometry.intersect_stream(chunk, out);
+                black_box(&*out).iter().filter(|h| h.is_some()).count()
+            })
+            .sum()
+    })
+}
+
 fn occluded_all(pool: &rayon::ThreadPool, geometry: &Geometry, rays: &[Ray]) -> usize {
     pool.install(|| {
         rays.par_chunks(CHUNK)
@@ -156,6 +169,12 @@ fn bench_rays(c: &mut Criterion) {
             });
             group.bench_function(format!("closest_incoherent/{threads}t"), |b| {
                 b.iter(|| trace_all(pool, &geometry, &incoherent))
+            });
+            group.bench_function(format!("stream_coherent/{threads}t"), |b| {
+                b.iter(|| trace_stream(pool, &geometry, &coherent))
+            });
+            group.bench_function(format!("stream_incoherent/{threads}t"), |b| {
+                b.iter(|| trace_stream(pool, &geometry, &incoherent))
             });
         }
         group.bench_function("anyhit_incoherent/1t", |b| {

@@ -792,3 +792,53 @@ fn build_does_not_depend_on_thread_count() {
     assert!(one.iter().filter(|h| h.is_some()).count() > 10_000);
     assert_eq!(one, hits(3));
 }
+
+#[test]
+fn stream_queries_match_single_ray_queries() {
+    // `intersect_stream` interleaves several traversals; each must still find exactly what
+    // `intersect` finds (same surface, same bits), whatever the mix of shapes, segment
+    // lengths and unusable rays in the stream.
+    let mut shapes = scaled_scene(1.0, Vec3::ZERO);
+    shapes.push(mesh_shape(
+        "dense",
+        uv_sphere_with_triangles(Vec3::new(0.4, 0.3, 0.5), 0.2, 20_000),
+    ));
+    let g = Geometry::build(&shapes);
+    let mut rng = Random::new(77);
+    let b = g.bounds();
+    let mut rays: Vec<Ray> = (0..20_000)
+        .map(|i| {
+            let mut ray = Ray::new(rng.in_box(b.min, b.max), rng.direction());
+            if i % 3 == 0 {
+                ray.t_max = rng.f32() * 0.5;
+            }
+            ray
+        })
+        .collect();
+    rays[5].d = Vec3::ZERO;
+    rays[6].o = Vec3::NAN;
+    rays[7].t_max = -1.0;
+    let mut out = Vec::new();
+    g.intersect_stream(&rays, &mut out);
+    assert_eq!(out.len(), rays.len());
+    let mut hits = 0;
+    for (ray, streamed) in rays.iter().zip(&out) {
+        match (g.intersect(ray), streamed) {
+            (None, None) => {}
+            (Some(a), Some(s)) => {
+                hits += 1;
+                assert_eq!((a.shape, a.primitive), (s.shape, s.primitive), "{ray:?}");
+                assert_eq!(a.t.to_bits(), s.t.to_bits(), "{ray:?}");
+                assert_eq!(a.p, s.p, "{ray:?}");
+                assert_eq!(a.ns, s.ns, "{ray:?}");
+            }
+            (a, s) => panic!(
+                "{ray:?}: single {:?}, stream {:?}",
+                a.is_some(),
+                s.is_some()
+            ),
+        }
+    }
+    // The test means something only if most rays hit and some miss.
+    assert!(hits > rays.len() / 2 && hits < rays.len(), "{hits} hits");
+}

@@ -24,6 +24,10 @@ use obvhs::{
 };
 use rayon::prelude::*;
 
+mod stream;
+
+pub use stream::IN_FLIGHT;
+
 use super::cwbvh;
 use super::offset::gamma;
 use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord};

@@ -176,6 +176,7 @@ impl Bounds3 {
 }
 
 /// The closest hit found by traversal (before computing surface data).
+#[derive(Clone, Copy)]
 enum Hit {
     Triangle {
         record: u32,
@@ -196,6 +197,7 @@ enum Hit {
 /// component lies in [1, 2): exactly the same ray (the scaling is exact), with slab
 /// reciprocals that cannot overflow whatever |d| the caller used. Distances t_s along it
 /// convert back exactly: t = t_s / scale.
+#[derive(Clone, Copy)]
 struct ScaledRay {
     o: Vec3,
     d: Vec3,
@@ -317,6 +319,47 @@ impl Geometry {
     /// Closest hit along the ray, if any, with t < ray.t_max.
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
         let r = ScaledRay::new(ray)?;
+        let (mut hit, t_max) = self.closest_analytic(&r);
+        if let Some((record, h)) = self.bvh.closest(&TraversalRay::new(r.o, r.d), t_max) {
+            hit = Some(Hit::Triangle { record, hit: h });
+        }
+        Some(self.hit_interaction(hit?, &r))
+    }
+
+    /// `out[i] = self.intersect(&rays[i])` for every ray, with several BVH traversals in
+    /// flight (`bvh/stream.rs`): the same results, faster where the scene does not fit in the
+    /// cache and each node read waits on memory.
+    pub fn intersect_stream(&self, rays: &[Ray], out: &mut Vec<Option<SurfaceInteraction>>) {
+        out.clear();
+        out.resize(rays.len(), None);
+        let mut queued = Vec::with_capacity(rays.len());
+        let mut traversal = Vec::with_capacity(rays.len());
+        let mut t_max = Vec::with_capacity(rays.len());
+        for (i, ray) in rays.iter().enumerate() {
+            let Some(r) = ScaledRay::new(ray) else {
+                continue;
+            };
+            let (hit, t) = self.closest_analytic(&r);
+            traversal.push(TraversalRay::new(r.o, r.d));
+            t_max.push(t);
+            queued.push((i, r, hit));
+        }
+        self.bvh.closest_stream(&traversal, &t_max, |k, h| {
+            if let Some((record, h)) = h {
+                queued[k].2 = Some(Hit::Triangle { record, hit: h });
+            }
+        });
+        for (i, r, hit) in queued {
+            if let Some(h) = hit {
+                out[i] = Some(self.hit_interaction(h, &r));
+            }
+        }
+    }
+
+    /// The closest sphere or disk hit and the segment left for the triangles: t_max in the
+    /// scaled ray's units, shortened to the analytic hit if there is one.
+    #[inline(always)]
+    fn closest_analytic(&self, r: &ScaledRay) -> (Option<Hit>, f32) {
         let mut t_max64 = r.t_max as f64;
         let mut hit = None;
         for (index, s) in self.spheres.iter().enumerate() {
@@ -331,21 +374,23 @@ impl Geometry {
                 hit = Some(Hit::Disk { index, t, local });
             }
         }
-        let traversal = TraversalRay::new(r.o, r.d);
         let t_max = if hit.is_some() {
             t_max64 as f32
         } else {
             r.t_max
         };
-        if let Some((record, h)) = self.bvh.closest(&traversal, t_max) {
-            hit = Some(Hit::Triangle { record, hit: h });
-        }
-        match hit? {
-            Hit::Triangle { record, hit } => Some(self.triangle_interaction(record, &hit, r.scale)),
+        (hit, t_max)
+    }
+
+    /// The surface data of a hit found along the scaled ray `r`.
+    #[inline(always)]
+    fn hit_interaction(&self, hit: Hit, r: &ScaledRay) -> SurfaceInteraction {
+        match hit {
+            Hit::Triangle { record, hit } => self.triangle_interaction(record, &hit, r.scale),
             Hit::Sphere { index, t } => {
                 let s = &self.spheres[index];
                 let h = s.hit(r.o, r.d, t);
-                Some(interaction(
+                interaction(
                     h.p,
                     h.p_error,
                     (t / r.scale as f64) as f32,
@@ -354,12 +399,12 @@ impl Geometry {
                     h.uv,
                     s.shape,
                     0,
-                ))
+                )
             }
             Hit::Disk { index, t, local } => {
                 let d = &self.disks[index];
                 let h = d.hit(local);
-                Some(interaction(
+                interaction(
                     h.p,
                     h.p_error,
                     (t / r.scale as f64) as f32,
@@ -368,7 +413,7 @@ impl Geometry {
                     h.uv,
                     d.shape,
                     0,
-                ))
+                )
             }
         }
     }
