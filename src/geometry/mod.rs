@@ -438,6 +438,7 @@ impl Geometry {
         self.bvh.any(&TraversalRay::new(r.o, r.d), r.t_max)
     }
 
+    #[inline(always)]
     fn triangle_interaction(&self, record: u32, h: &TriangleHit, scale: f32) -> SurfaceInteraction {
         let rec = self.bvh.record(record);
         let v = [rec.vertex(0), rec.vertex(1), rec.vertex(2)];

@@ -52,21 +52,38 @@ pub fn next_float_down(v: f32) -> f32 {
 /// point. Moving `p` by δ along ±ng, to the side of `w`, puts the origin on that side of
 /// the plane; the addition itself rounds, so each coordinate is then moved one more float
 /// away from `p`, in the direction of the offset, which cannot bring it back.
+#[inline]
 pub fn offset_ray_origin(p: Vec3, p_error: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
     let delta = ng.abs().dot(p_error);
-    let mut offset = ng * delta;
-    if w.dot(ng) < 0.0 {
-        offset = -offset;
+    let side = if w.dot(ng) < 0.0 { -delta } else { delta };
+    let offset = ng * side;
+    let po = p + offset;
+    // Branch-free (the sides are random): each coordinate moves one float towards the
+    // sign of its offset, none where the offset is zero.
+    Vec3::new(
+        step_towards(po.x, offset.x),
+        step_towards(po.y, offset.y),
+        step_towards(po.z, offset.z),
+    )
+}
+
+/// `next_float_up(v)` for `dir` > 0, `next_float_down(v)` for `dir` < 0, `v` for `dir` = 0
+/// (and for non-finite `v`), without branches.
+#[inline(always)]
+fn step_towards(v: f32, dir: f32) -> f32 {
+    // next_float_down(v) = −next_float_up(−v): step |v| up or down in the direction of dir
+    // with the sign folded in. u = v·sign(dir) (as bits, no rounding); −0 counts as +0.
+    let flip = if dir < 0.0 { 0x8000_0000u32 } else { 0 };
+    let u = f32::from_bits(v.to_bits() ^ flip);
+    let u = if u == 0.0 { 0.0 } else { u };
+    let bits = u.to_bits();
+    let up = if u >= 0.0 { bits + 1 } else { bits - 1 };
+    let stepped = f32::from_bits(up ^ flip);
+    if dir == 0.0 || !v.is_finite() {
+        v
+    } else {
+        stepped
     }
-    let mut po = p + offset;
-    for i in 0..3 {
-        if offset[i] > 0.0 {
-            po[i] = next_float_up(po[i]);
-        } else if offset[i] < 0.0 {
-            po[i] = next_float_down(po[i]);
-        }
-    }
-    po
 }
 
 #[cfg(test)]
@@ -106,5 +123,32 @@ mod tests {
         let delta = n.abs().dot(e);
         assert!((up - p).dot(n) >= delta * 0.999);
         assert!((down - p).dot(n) <= -delta * 0.999);
+    }
+
+    #[test]
+    fn step_towards_matches_next_float() {
+        for v in [
+            1.0f32,
+            -1.0,
+            0.0,
+            -0.0,
+            1e-40,
+            -1e-40,
+            3.5e5,
+            -2.5e-3,
+            f32::MAX,
+        ] {
+            assert_eq!(
+                step_towards(v, 1.0).to_bits(),
+                next_float_up(v).to_bits(),
+                "{v}"
+            );
+            assert_eq!(
+                step_towards(v, -0.5).to_bits(),
+                next_float_down(v).to_bits(),
+                "{v}"
+            );
+            assert_eq!(step_towards(v, 0.0).to_bits(), v.to_bits(), "{v}");
+        }
     }
 }
