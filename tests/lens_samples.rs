@@ -235,7 +235,7 @@ fn structured_lens_samples_beat_independent_ones_and_agree_with_them() {
     // and the lens point. Mean relMSE over 4 seeds at 64 spp against a 4096-spp Sobol'
     // reference; then, at 1024 spp, as close to the reference as independent samples.
     // (Measured with 8 seeds: independent 4.4e-3; with the lens samples drawn independently
-    // instead of from the pattern, stratified 3.3e-3, Poisson 3.4e-3, CCVT 2.9e-3, Sobol'
+    // instead of from the pattern (a throwaway build), stratified 3.3e-3, Poisson 3.4e-3, CCVT 2.9e-3, Sobol'
     // 3.1e-3; from the pattern, 2.2e-3, 2.5e-3, 2.8e-3 and 1.2e-3. At 16 spp the gains are
     // smaller: 1.65e-2 against 1.29e-2, 1.18e-2, 1.00e-2 and 0.91e-2.)
     let scene = dof_scene();
