@@ -1,5 +1,5 @@
-//! Mitsuba 3's `perspective` sensor: a pinhole camera looking down +z in camera space,
-//! +y up, pixel (0, 0) at the top left of the image.
+//! Mitsuba 3's `perspective` and `thinlens` sensors: a camera looking down +z in camera
+//! space, +y up, pixel (0, 0) at the top left of the image.
 //!
 //! The model, as Mitsuba 3 defines it (its `perspective_projection`): a camera-space point
 //! (x, y, z) with z > 0 lands at the normalised image position
@@ -18,20 +18,31 @@
 //! Rays start on the near plane (Mitsuba 3 moves the origin to the near plane and shortens
 //! `maxt` accordingly); `Ray::t_max` ends them on the far plane.
 //!
-//! Light tracing: `importance` (We) and `pdf_direction` are the pinhole's sensor response and
-//! the solid-angle density of `generate_ray` at uniformly sampled raster positions; `connect`
-//! is the camera end of a light-tracing connection. A light path's contribution splatted
-//! with `Film::splat` needs the splat scale width · height / (number of light paths) to give
-//! per-pixel values in the same units as the camera-side estimates.
+//! Depth of field (`thinlens`, `ThinLens`): the pinhole becomes a lens of radius r focused
+//! on the plane z = F. `sample_ray` takes a lens sample besides the raster position; camera
+//! estimators draw it as the second 2D sample of each pixel sample, right after the pixel
+//! position, and only for a camera with a lens (`has_lens`), so a pinhole's images do not
+//! depend on it. `generate_ray` and `project` are the chief ray (through the lens centre):
+//! exact for a pinhole, and for a thin lens where points on the focus plane land.
 //!
-//! Not here yet: the thin-lens camera (`thinlens`, depth of field).
+//! Light tracing: `importance` (We) and `pdf_direction` are the pinhole's sensor response and
+//! the solid-angle density of `generate_ray` at uniformly sampled raster positions (for a
+//! thin lens, of its chief rays only). `connect` (pinhole only) and `connect_lens` (any
+//! camera, given a lens sample) are the camera end of a light-tracing connection. A light path's contribution splatted with `Film::splat` needs
+//! the splat scale width · height / (number of light paths) to give per-pixel values in the
+//! same units as the camera-side estimates.
+
+mod thin_lens;
+
+pub use thin_lens::ThinLens;
 
 use glam::{Vec2, Vec3};
 
 use crate::geometry::Ray;
 use crate::scene::{FovAxis, SensorDesc};
 
-/// A pinhole camera (`<sensor type="perspective">`).
+/// A pinhole (`<sensor type="perspective">`) or thin-lens (`<sensor type="thinlens">`)
+/// camera.
 #[derive(Clone, Debug)]
 pub struct Camera {
     to_world: crate::math::Transform,
@@ -49,6 +60,8 @@ pub struct Camera {
     position: Vec3,
     /// The viewing direction (camera +z) in world space, unit length.
     forward: Vec3,
+    /// The thin lens, or `None` for a pinhole.
+    lens: Option<ThinLens>,
 }
 
 /// The camera end of a connection from a world point (light tracing, BDPT t = 1).
@@ -56,15 +69,17 @@ pub struct Camera {
 pub struct CameraConnection {
     /// Where the point lands on the film.
     pub raster: Vec2,
-    /// The pinhole in world space.
+    /// The pinhole (or the sampled lens point) in world space.
     pub camera_position: Vec3,
-    /// Unit direction from the point towards the pinhole.
+    /// Unit direction from the point towards `camera_position`.
     pub direction_to_camera: Vec3,
-    /// Distance from the point to the pinhole.
+    /// Distance from the point to `camera_position`.
     pub distance: f32,
     /// We(ω) · cos θ_camera / distance²  =  1 / (A cos³θ · distance²), with A the image
     /// area on the plane z = 1. Multiply by the path throughput, the BSDF at the point and
-    /// the cosine there to get the connection's contribution (Veach 1997, §10.2).
+    /// the cosine there to get the connection's contribution (Veach 1997, §10.2). For a
+    /// thin lens this already divides by the density 1 / (π r²) of the lens point, which
+    /// cancels the lens area in We (pbrt-v3 §16.1.1), so the formula is the pinhole's.
     pub importance: f32,
 }
 
@@ -113,7 +128,18 @@ impl Camera {
             plane_area: plane_area as f32,
             position: to_world.point(Vec3::ZERO),
             forward: to_world.vector(Vec3::Z).normalize(),
+            lens: sensor.lens.as_ref().map(ThinLens::new),
         }
+    }
+
+    /// Whether the camera has a lens, i.e. whether `sample_ray` uses its lens sample.
+    pub fn has_lens(&self) -> bool {
+        self.lens.is_some()
+    }
+
+    /// The thin lens, if any.
+    pub fn lens(&self) -> Option<&ThinLens> {
+        self.lens.as_ref()
     }
 
     pub fn width(&self) -> u32 {
@@ -159,14 +185,34 @@ impl Camera {
     /// x in [0, width), y in [0, height), (0, 0) = top-left corner of the top-left pixel).
     /// Its direction is unit length and it starts at the near clip plane; `t_max` ends it on
     /// the far clip plane (both planes are z = const in camera space, as in Mitsuba 3).
+    /// For a thin lens this is the chief ray, through the lens centre.
     pub fn generate_ray(&self, raster: Vec2) -> Ray {
         let d_camera = self.camera_direction(raster).normalize();
+        self.clipped_ray(self.position, d_camera)
+    }
+
+    /// The primary ray through raster position `raster` and lens sample `lens` ∈ [0, 1)²:
+    /// for a thin lens, from the lens point of `lens` towards the point of the focus plane
+    /// that `raster` sees (`ThinLens`); for a pinhole, `generate_ray(raster)`, ignoring
+    /// `lens`. Clipped as `generate_ray`'s; its weight is 1 (Mitsuba 3's `sample_ray`).
+    pub fn sample_ray(&self, raster: Vec2, lens: Vec2) -> Ray {
+        let Some(thin) = &self.lens else {
+            return self.generate_ray(raster);
+        };
+        let a = thin.point(lens);
+        let d_camera = thin.direction(a, self.camera_direction(raster));
+        self.clipped_ray(self.to_world.point(a), d_camera)
+    }
+
+    /// The ray from world point `origin` (on the camera plane z = 0) along the unit
+    /// camera-space direction `d_camera`, cut to the clip planes z = near and z = far.
+    fn clipped_ray(&self, origin: Vec3, d_camera: Vec3) -> Ray {
         let d = self.to_world.vector(d_camera).normalize();
         let inv_z = 1.0 / d_camera.z;
         let near_t = self.near_clip * inv_z;
         let far_t = self.far_clip * inv_z;
         Ray {
-            o: self.position + d * near_t,
+            o: origin + d * near_t,
             d,
             t_max: far_t - near_t,
         }
@@ -174,13 +220,38 @@ impl Camera {
 
     /// The raster position a world point projects to, or None when it is behind the
     /// camera, outside the image or outside the clip range. As in Mitsuba 3 the image
-    /// bounds are inclusive: the result lies in [0, width] × [0, height].
+    /// bounds are inclusive: the result lies in [0, width] × [0, height]. For a thin lens
+    /// this is the projection through the lens centre.
     pub fn project(&self, p: Vec3) -> Option<Vec2> {
         let q = self.to_world.inverse.transform_point3(p);
-        // Negated comparisons also reject NaN.
-        if !(q.z >= self.near_clip && q.z <= self.far_clip) {
+        if !self.in_clip_range(q) {
             return None;
         }
+        self.raster_of(q)
+    }
+
+    /// Where world point `p` lands seen through lens sample `lens` (see `sample_ray`): the
+    /// raster position whose ray from that lens point passes through `p`, or None outside
+    /// the image or the clip range. For a pinhole, `project(p)`.
+    pub fn project_through_lens(&self, p: Vec3, lens: Vec2) -> Option<Vec2> {
+        let Some(thin) = &self.lens else {
+            return self.project(p);
+        };
+        let q = self.to_world.inverse.transform_point3(p);
+        if !self.in_clip_range(q) {
+            return None;
+        }
+        self.raster_of(thin.on_plane(thin.point(lens), q))
+    }
+
+    /// Whether camera-space point `q` lies between the clip planes (NaN does not).
+    fn in_clip_range(&self, q: Vec3) -> bool {
+        q.z >= self.near_clip && q.z <= self.far_clip
+    }
+
+    /// The raster position of the pinhole projection of camera-space point `q` (q.z > 0),
+    /// or None outside the image.
+    fn raster_of(&self, q: Vec3) -> Option<Vec2> {
         let s = 0.5 / (q.z * self.tan_half_x);
         let u = 0.5 - q.x * s;
         let v = 0.5 - self.aspect * q.y * s;
@@ -226,11 +297,36 @@ impl Camera {
         (x.abs() <= self.tan_half_x && y.abs() <= half_h).then_some(d.z)
     }
 
-    /// The camera end of a connection from world point `p`: None when `p` is outside the
-    /// image or the clip range. Visibility is the caller's business.
+    /// The camera end of a connection from world point `p` to a pinhole: None when `p` is
+    /// outside the image or the clip range, and always None for a thin lens, whose lens
+    /// point must be sampled (`connect_lens`). Visibility is the caller's business.
     pub fn connect(&self, p: Vec3) -> Option<CameraConnection> {
-        let raster = self.project(p)?;
-        let to_camera = self.position - p;
+        if self.lens.is_some() {
+            return None;
+        }
+        self.connect_from(p, self.position, self.project(p)?)
+    }
+
+    /// The camera end of a connection from world point `p` to the lens point of lens sample
+    /// `lens` (uniform over the aperture when `lens` is uniform over the square); for a
+    /// pinhole the same as `connect(p)`.
+    pub fn connect_lens(&self, p: Vec3, lens: Vec2) -> Option<CameraConnection> {
+        let Some(thin) = &self.lens else {
+            return self.connect(p);
+        };
+        let raster = self.project_through_lens(p, lens)?;
+        self.connect_from(p, self.to_world.point(thin.point(lens)), raster)
+    }
+
+    /// The connection from `p` to the camera point `camera_position` (world space) at which
+    /// `p` lands on `raster`.
+    fn connect_from(
+        &self,
+        p: Vec3,
+        camera_position: Vec3,
+        raster: Vec2,
+    ) -> Option<CameraConnection> {
+        let to_camera = camera_position - p;
         let distance = to_camera.length();
         if distance.is_nan() || distance <= 0.0 {
             return None;
@@ -248,7 +344,7 @@ impl Camera {
         let importance = 1.0 / (self.plane_area * cos * cos * cos * distance * distance);
         Some(CameraConnection {
             raster,
-            camera_position: self.position,
+            camera_position,
             direction_to_camera,
             distance,
             importance,

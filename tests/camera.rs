@@ -30,6 +30,7 @@ fn sensor(to_world: Transform, fov: f32, axis: FovAxis, width: u32, height: u32)
         fov_axis: axis,
         near_clip: 0.01,
         far_clip: 1000.0,
+        lens: None,
         film: FilmDesc {
             width,
             height,

@@ -278,6 +278,105 @@ fn perspective_sensor_reads_every_parameter() {
 }
 
 #[test]
+fn thinlens_sensor_reads_aperture_and_focus_distance() {
+    let desc = load_ok(
+        "thinlens_all",
+        &with_sphere(
+            r#"<sensor type="thinlens">
+                 <float name="fov" value="40"/>
+                 <float name="near_clip" value="0.1"/>
+                 <float name="far_clip" value="80"/>
+                 <float name="aperture_radius" value="0.125"/>
+                 <float name="focus_distance" value="3.5"/>
+                 <transform name="to_world"><lookat origin="0,0,5" target="0,0,0" up="0,1,0"/></transform>
+               </sensor>"#,
+        ),
+    );
+    let s = &desc.sensor;
+    assert_eq!(s.fov_degrees, 40.0);
+    assert_eq!((s.near_clip, s.far_clip), (0.1, 80.0));
+    assert_eq!(
+        s.lens,
+        Some(ThinLensDesc {
+            aperture_radius: 0.125,
+            focus_distance: 3.5
+        })
+    );
+    let lens_warnings = |d: &SceneDescription| {
+        d.warnings
+            .iter()
+            .filter(|w| w.contains("aperture"))
+            .cloned()
+            .collect::<Vec<_>>()
+    };
+    assert!(lens_warnings(&desc).is_empty(), "{:?}", desc.warnings);
+    // focus_distance defaults to far_clip (Mitsuba 3.9.1's code; its documentation says 0).
+    let desc = load_ok(
+        "thinlens_default_focus",
+        &with_sphere(
+            r#"<sensor type="thinlens"><float name="far_clip" value="70"/><float name="aperture_radius" value="0.5"/></sensor>"#,
+        ),
+    );
+    assert_eq!(desc.sensor.lens.unwrap().focus_distance, 70.0);
+    // A perspective sensor has no lens (and ignores focus_distance, as Mitsuba does).
+    let desc = load_ok(
+        "perspective_no_lens",
+        &with_sphere(r#"<sensor type="perspective"/>"#),
+    );
+    assert_eq!(desc.sensor.lens, None);
+    // Radius 0 is a pinhole: allowed, with a warning naming the line (Mitsuba warns too).
+    let text = with_sphere(
+        "<sensor type=\"thinlens\">\n<float name=\"aperture_radius\" value=\"0\"/></sensor>",
+    );
+    let desc = load_ok("thinlens_zero", &text);
+    assert_eq!(desc.sensor.lens.unwrap().aperture_radius, 0.0);
+    let warnings = lens_warnings(&desc);
+    assert_eq!(warnings.len(), 1, "{:?}", desc.warnings);
+    assert!(warnings[0].contains("scene.xml:4"), "{warnings:?}");
+}
+
+#[test]
+fn bad_thinlens_parameters_are_errors_naming_file_and_line() {
+    for (body, line, needle) in [
+        (
+            "<sensor type=\"thinlens\">\n<float name=\"aperture_radius\" value=\"-0.1\"/></sensor>",
+            4,
+            "aperture_radius",
+        ),
+        (
+            "<sensor type=\"thinlens\">\n<float name=\"aperture_radius\" value=\"nan\"/></sensor>",
+            4,
+            "aperture_radius",
+        ),
+        (
+            "<sensor type=\"thinlens\">\n<float name=\"aperture_radius\" value=\"inf\"/></sensor>",
+            4,
+            "aperture_radius",
+        ),
+        // Mitsuba 3 has no default radius either.
+        (
+            "<sensor type=\"thinlens\">\n<float name=\"focus_distance\" value=\"2\"/></sensor>",
+            3,
+            "aperture_radius",
+        ),
+        (
+            "<sensor type=\"thinlens\"><float name=\"aperture_radius\" value=\"0.1\"/>\n<float name=\"focus_distance\" value=\"0\"/></sensor>",
+            4,
+            "focus_distance",
+        ),
+        (
+            "<sensor type=\"thinlens\"><float name=\"aperture_radius\" value=\"0.1\"/>\n<float name=\"focus_distance\" value=\"-3\"/></sensor>",
+            4,
+            "focus_distance",
+        ),
+    ] {
+        let (message, file) = load_err("thinlens_bad", &with_sphere(body));
+        assert_names(&message, &file, line);
+        assert!(message.contains(needle), "{needle}: {message}");
+    }
+}
+
+#[test]
 fn all_five_fov_axes_parse() {
     for (name, axis) in [
         ("x", FovAxis::X),
@@ -1573,7 +1672,10 @@ fn structure_errors() {
 #[test]
 fn unsupported_features_say_so() {
     for (body, element) in [
-        ("<sensor type=\"thinlens\"/>", "<sensor type=\"thinlens\">"),
+        (
+            "<sensor type=\"orthographic\"/>",
+            "<sensor type=\"orthographic\">",
+        ),
         ("<emitter type=\"sunsky\"/>", "<emitter type=\"sunsky\">"),
         (
             "<medium type=\"homogeneous\" id=\"fog\"/>",

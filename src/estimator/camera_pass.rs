@@ -51,12 +51,20 @@ pub fn camera_pass(
         .map(|&rect| {
             let mut tile = film.tile(rect);
             let mut counts = PassCounts::default();
-            let mut sampler = CameraSampler::new(seed, pixel_samples.clone());
+            let camera = &scene.camera;
+            let mut sampler = CameraSampler::new(seed, pixel_samples.clone())
+                .with_lens_samples(camera.has_lens());
             for y in rect.y0..rect.y1 {
                 for x in rect.x0..rect.x1 {
                     sampler.start_pixel_sample((x, y), pass_index as u64);
+                    // The pixel position, then (only for a lens) the lens sample: the first
+                    // two 2D samples of the pixel sample (`CameraSampler`).
                     let raster = raster_in_pixel(x, y, sampler.next_2d());
-                    let ray = scene.camera.generate_ray(raster);
+                    let ray = if camera.has_lens() {
+                        camera.sample_ray(raster, sampler.next_2d())
+                    } else {
+                        camera.generate_ray(raster)
+                    };
                     let (value, rays) = estimate.radiance(scene, &ray, &mut sampler);
                     counts.samples += 1;
                     counts.rays += rays;

@@ -7,6 +7,7 @@
 pub mod ccvt;
 pub mod independent;
 pub mod pattern;
+pub mod permutation;
 pub mod pixel_samples;
 pub mod poisson;
 pub mod regular;

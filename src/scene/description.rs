@@ -66,6 +66,8 @@ pub struct SensorDesc {
     pub fov_axis: FovAxis,
     pub near_clip: f32,
     pub far_clip: f32,
+    /// `thinlens`: the lens; `None` for `perspective` (a pinhole).
+    pub lens: Option<ThinLensDesc>,
     pub film: FilmDesc,
     /// `<sampler sample_count>`: the default samples per pixel.
     pub sample_count: u32,
@@ -79,10 +81,21 @@ impl Default for SensorDesc {
             fov_axis: FovAxis::X,
             near_clip: 1e-2,
             far_clip: 1e4,
+            lens: None,
             film: FilmDesc::default(),
             sample_count: 4,
         }
     }
+}
+
+/// The lens of `<sensor type="thinlens">` (Mitsuba 3 conventions).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ThinLensDesc {
+    /// Radius of the circular aperture, in scene units (≥ 0; 0 is a pinhole).
+    pub aperture_radius: f32,
+    /// Distance from the lens to the plane in focus, measured along the viewing axis
+    /// (the plane z = focus_distance in camera space), in scene units (> 0).
+    pub focus_distance: f32,
 }
 
 /// `<film type="hdrfilm">`.
