@@ -5,18 +5,33 @@
 //! For the disk (a discontinuity along a curve) Pilleboue et al. 2015 give the rates the
 //! lecture quotes: random N⁻¹, jittered N⁻¹·⁵, Poisson disk N⁻¹, CCVT N⁻¹·⁵; a smooth
 //! integrand lets jittered sampling reach N⁻² in 2D.
+//!
+//! Those rates are asymptotic, so slopes are fitted over the later half of each pattern's
+//! point counts (`fit_later_half`, DESIGN.md §5's rule for convergence slopes). Poisson disk
+//! needs it most. With P(ν) the expected power spectrum of the points (P = 1 for random
+//! points), Pilleboue et al.'s Var = (1/N)·Σ_{ν≠0} |f̂(ν)|² P(ν); dart throwing leaves a
+//! low-frequency plateau P₀ > 0 (≈ 0.06 at `poisson::RELATIVE_RADIUS` = 0.75) inside its
+//! blue-noise ring at |ν| ≈ √N. The disk's |f̂|² ∝ |ν|⁻³ puts most of Σ|f̂|² = a(1 − a),
+//! a its area, at low ν, so N·Var ≈ P₀·a(1 − a) + B/√N (measured: B ≈ 0.14). The B term,
+//! power above the ring, falls like N⁻¹·⁵ and dominates below N ≈ 130, so the local slope
+//! is −1.37 at N = 16 … 32, −1.14 at 512 … 1024 and about −1.05 above 8192 (65536 … 128
+//! realisations per N, 64 translations each). `experiments/sampling-rates.toml` therefore
+//! runs every pattern but CCVT to N = 181², so that the fit takes N = 32² … 181².
 
+use std::collections::BTreeMap;
 use std::f64::consts::PI;
 use std::fmt::Write as _;
 
 use glam::Vec2;
+use rayon::prelude::*;
 use serde::Deserialize;
 
 use crate::error::{Error, Location, Result};
 use crate::experiment::plot::{Band, Series, convergence_plot};
-use crate::experiment::statistics::{SlopeFit, fit_power_law};
+use crate::experiment::statistics::{SlopeFit, fit_later_half, later_half};
 use crate::io::atomic::write_file_atomically;
-use crate::sampler::pattern::{Pattern, points};
+use crate::sampler::independent::{IndependentSampler, hash_words};
+use crate::sampler::pattern::{Pattern, points, uniform_f64};
 
 /// `experiments/sampling-rates.toml`.
 #[derive(Debug, Deserialize)]
@@ -26,13 +41,33 @@ pub struct SamplingRatesSpec {
     pub description: String,
     /// Grid sides k: the point counts are N = k² (square, so every pattern gets its grid).
     pub sides: Vec<usize>,
+    /// Sides for one pattern instead of `sides` (CCVT, whose optimisation is slow at large N).
+    #[serde(default)]
+    pub pattern_sides: BTreeMap<String, Vec<usize>>,
     /// Independent realisations per (pattern, N).
     pub realisations: usize,
+    /// Random translations of the disk per realisation (see `Settings::shifts`).
+    pub shifts: usize,
     #[serde(default)]
     pub seed: u64,
     /// Patterns to compare (default: all).
     #[serde(default)]
     pub patterns: Vec<String>,
+}
+
+/// How each MSE is measured.
+#[derive(Clone, Copy, Debug)]
+pub struct Settings {
+    /// Independent point sets per N.
+    pub realisations: usize,
+    /// Translations of the disk on the unit torus per point set, each uniform: the disk
+    /// estimate is that of Pilleboue et al.'s homogenised (randomly translated) pattern, which
+    /// is what their rates describe. Averaging several translations of one point set lowers the
+    /// noise of the MSE at little cost (S·N indicator evaluations against generating the set).
+    /// The smooth integrand is not translated: on the torus it would have kinks along the
+    /// seam, and its rates (jittered N⁻², Owen-scrambled Sobol' N⁻³) are for it as it is.
+    pub shifts: usize,
+    pub seed: u64,
 }
 
 /// The two integrands over [0, 1]².
@@ -44,7 +79,13 @@ pub enum Integrand {
     Disk,
 }
 
+/// The disk's radius and centre.
+const DISK_RADIUS: f64 = 0.3;
+const DISK_CENTRE: (f64, f64) = (0.47, 0.52);
+
 impl Integrand {
+    pub const ALL: [Integrand; 2] = [Integrand::Smooth, Integrand::Disk];
+
     pub fn name(self) -> &'static str {
         match self {
             Integrand::Smooth => "smooth",
@@ -56,17 +97,14 @@ impl Integrand {
         let (x, y) = (p.x as f64, p.y as f64);
         match self {
             Integrand::Smooth => (PI * x).sin() * (PI * y).sin(),
-            Integrand::Disk => {
-                let (dx, dy) = (x - 0.47, y - 0.52);
-                if dx * dx + dy * dy < 0.09 { 1.0 } else { 0.0 }
-            }
+            Integrand::Disk => disk_indicator(x - DISK_CENTRE.0, y - DISK_CENTRE.1),
         }
     }
 
     pub fn integral(self) -> f64 {
         match self {
             Integrand::Smooth => 4.0 / (PI * PI),
-            Integrand::Disk => 0.09 * PI,
+            Integrand::Disk => PI * DISK_RADIUS * DISK_RADIUS,
         }
     }
 
@@ -85,40 +123,94 @@ impl Integrand {
     }
 }
 
-/// Mean squared error of the N-point estimate over `realisations` seeds.
-pub fn mse(
-    pattern: Pattern,
-    integrand: Integrand,
-    n: usize,
-    realisations: usize,
-    seed: u64,
-) -> f64 {
-    let truth = integrand.integral();
-    (0..realisations)
-        .map(|r| {
-            let pts = points(pattern, n, seed ^ ((r as u64) << 20) ^ n as u64);
-            let estimate = pts.iter().map(|&p| integrand.eval(p)).sum::<f64>() / pts.len() as f64;
-            (estimate - truth).powi(2)
-        })
-        .sum::<f64>()
-        / realisations as f64
+/// 1 if the offset (dx, dy) from the disk's centre, taken on the unit torus, is inside it.
+/// The disk's diameter is below 1, so on the torus it is still a disk of area 0.09π.
+fn disk_indicator(dx: f64, dy: f64) -> f64 {
+    let wrap = |d: f64| d - (d + 0.5).floor();
+    let (dx, dy) = (wrap(dx), wrap(dy));
+    if dx * dx + dy * dy < DISK_RADIUS * DISK_RADIUS {
+        1.0
+    } else {
+        0.0
+    }
 }
 
-/// MSE against N for every side in `sides`, and the fitted slope.
-pub fn rate(
-    pattern: Pattern,
-    integrand: Integrand,
-    sides: &[usize],
-    realisations: usize,
-    seed: u64,
-) -> (Vec<f64>, Vec<f64>, Option<SlopeFit>) {
-    let ns: Vec<f64> = sides.iter().map(|k| (k * k) as f64).collect();
-    let errors: Vec<f64> = sides
-        .iter()
-        .map(|k| mse(pattern, integrand, k * k, realisations, seed))
+/// The point set of realisation `r` (the experiment's seeds since its first version).
+fn realisation(pattern: Pattern, n: usize, r: usize, seed: u64) -> Vec<Vec2> {
+    points(pattern, n, seed ^ ((r as u64) << 20) ^ n as u64)
+}
+
+/// Mean squared error of the N-point estimate of each integrand, indexed like
+/// `Integrand::ALL`, over `settings.realisations` point sets (the disk also over
+/// `settings.shifts` translations of each). Realisations run in parallel; the sum is taken in
+/// their order, so the result does not depend on the thread count.
+pub fn mse(pattern: Pattern, n: usize, settings: Settings) -> [f64; 2] {
+    let per_set: Vec<[f64; 2]> = (0..settings.realisations)
+        .into_par_iter()
+        .map(|r| {
+            let pts = realisation(pattern, n, r, settings.seed);
+            let m = pts.len() as f64;
+            let smooth = pts.iter().map(|&p| Integrand::Smooth.eval(p)).sum::<f64>() / m;
+            let mut shift = IndependentSampler::new(hash_words(&[
+                settings.seed,
+                n as u64,
+                r as u64,
+                pattern as u64,
+                SHIFT_STREAM,
+            ]));
+            let disk = (0..settings.shifts)
+                .map(|_| {
+                    let t = (uniform_f64(&mut shift), uniform_f64(&mut shift));
+                    let (cx, cy) = (DISK_CENTRE.0 + t.0, DISK_CENTRE.1 + t.1);
+                    let estimate = pts
+                        .iter()
+                        .map(|p| disk_indicator(p.x as f64 - cx, p.y as f64 - cy))
+                        .sum::<f64>()
+                        / m;
+                    (estimate - Integrand::Disk.integral()).powi(2)
+                })
+                .sum::<f64>()
+                / settings.shifts as f64;
+            [(smooth - Integrand::Smooth.integral()).powi(2), disk]
+        })
         .collect();
-    let fit = fit_power_law(&ns, &errors);
-    (ns, errors, fit)
+    let r = settings.realisations as f64;
+    [
+        per_set.iter().map(|e| e[0]).sum::<f64>() / r,
+        per_set.iter().map(|e| e[1]).sum::<f64>() / r,
+    ]
+}
+
+/// Keeps the translations' random stream apart from the patterns' own.
+const SHIFT_STREAM: u64 = 0x0073_6869_6674; // "shift"
+
+/// One integrand's MSE against N.
+#[derive(Clone, Debug)]
+pub struct Curve {
+    pub ns: Vec<f64>,
+    pub errors: Vec<f64>,
+}
+
+impl Curve {
+    /// The power law fitted over the later half of the point counts, where the asymptotic
+    /// rate shows (see the module comment).
+    pub fn fit(&self) -> Option<SlopeFit> {
+        fit_later_half(&self.ns, &self.errors)
+    }
+}
+
+/// MSE against N = k² for every side k in `sides`, one curve per integrand (indexed like
+/// `Integrand::ALL`), both from the same point sets.
+pub fn rates(pattern: Pattern, sides: &[usize], settings: Settings) -> [Curve; 2] {
+    let ns: Vec<f64> = sides.iter().map(|k| (k * k) as f64).collect();
+    let errors: Vec<[f64; 2]> = sides
+        .iter()
+        .map(|k| mse(pattern, k * k, settings))
+        .collect();
+    [0, 1].map(|i| Curve {
+        ns: ns.clone(),
+        errors: errors.iter().map(|e| e[i]).collect(),
+    })
 }
 
 /// Runs the experiment into `out`: `summary.csv` (pattern, integrand, slope, slope_se),
@@ -126,9 +218,16 @@ pub fn rate(
 pub fn run(spec_path: &std::path::Path, text: &str, out: &std::path::Path) -> Result<()> {
     let fail = |m: String| Error::input(Location::file(spec_path), m);
     let spec: SamplingRatesSpec = toml::from_str(text).map_err(|e| fail(e.to_string()))?;
-    if spec.sides.len() < 3 || spec.sides.iter().any(|&k| k < 2) || spec.realisations < 2 {
+    let valid_sides = |sides: &[usize]| sides.len() >= 6 && sides.iter().all(|&k| k >= 2);
+    if !valid_sides(&spec.sides)
+        || !spec.pattern_sides.values().all(|s| valid_sides(s))
+        || spec.realisations < 2
+        || spec.shifts < 1
+    {
         return Err(fail(
-            "need at least 3 sides (each >= 2) and 2 realisations".into(),
+            "need at least 6 sides (each >= 2; the fit takes the later half) per pattern, 2 \
+             realisations and 1 shift"
+                .into(),
         ));
     }
     let patterns: Vec<Pattern> = if spec.patterns.is_empty() {
@@ -139,28 +238,50 @@ pub fn run(spec_path: &std::path::Path, text: &str, out: &std::path::Path) -> Re
             .map(|p| p.parse::<Pattern>().map_err(&fail))
             .collect::<Result<_>>()?
     };
+    let mut sides_of = BTreeMap::new();
+    for (name, sides) in &spec.pattern_sides {
+        sides_of.insert(name.parse::<Pattern>().map_err(&fail)?.name(), sides);
+    }
+    let settings = Settings {
+        realisations: spec.realisations,
+        shifts: spec.shifts,
+        seed: spec.seed,
+    };
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+    let curves: Vec<(Pattern, &[usize], [Curve; 2])> = patterns
+        .iter()
+        .map(|&pattern| {
+            let sides = sides_of.get(pattern.name()).map_or(&spec.sides[..], |s| s);
+            (pattern, sides, rates(pattern, sides, settings))
+        })
+        .collect();
     let mut csv = String::from("pattern,integrand,slope,slope_se,theory\n");
     let mut md = format!(
-        "# Experiment `sampling-rates`\n\n{}\n\nN = k² points for k in {:?}, {} realisations per \
-         point count, MSE of the estimate of the integral against its closed form. Reproduce \
-         with `cargo run --release -- run sampling-rates`.\n\n\
-         | pattern | integrand | fitted slope ± se | theory |\n|---|---|---|---|\n",
-        spec.description, spec.sides, spec.realisations
+        "# Experiment `sampling-rates`\n\n{}\n\nN = k² points, {} realisations per point \
+         count; the disk is also translated to {} uniform positions on the torus per \
+         realisation (Pilleboue et al.'s homogenised patterns). MSE of the estimate of the \
+         integral against its closed form; slopes fitted over the later half of each \
+         pattern's point counts (the asymptotic range). Reproduce with \
+         `cargo run --release -- run sampling-rates`.\n\n\
+         | pattern | sides k (fitted) | integrand | fitted slope ± se | theory |\n\
+         |---|---|---|---|---|\n",
+        spec.description, spec.realisations, spec.shifts
     );
-    for integrand in [Integrand::Smooth, Integrand::Disk] {
+    for (i, integrand) in Integrand::ALL.into_iter().enumerate() {
         let mut series = Vec::new();
-        for &pattern in &patterns {
-            let (ns, errors, fit) = rate(
-                pattern,
-                integrand,
-                &spec.sides,
-                spec.realisations,
-                spec.seed,
-            );
-            let theory = integrand.theory(pattern);
+        for (pattern, sides, curve) in &curves {
+            let curve = &curve[i];
+            let fitted = later_half(sides);
+            let theory = integrand.theory(*pattern);
             let t = theory.map(|t| format!("{t}")).unwrap_or_default();
-            match fit {
+            let sides_text = format!(
+                "{}…{} ({}…{})",
+                sides[0],
+                sides[sides.len() - 1],
+                fitted[0],
+                fitted[fitted.len() - 1]
+            );
+            match curve.fit() {
                 Some(f) => {
                     let _ = writeln!(
                         csv,
@@ -171,7 +292,7 @@ pub fn run(spec_path: &std::path::Path, text: &str, out: &std::path::Path) -> Re
                     );
                     let _ = writeln!(
                         md,
-                        "| {pattern} | {} | {:.2} ± {:.2} | {} |",
+                        "| {pattern} | {sides_text} | {} | {:.2} ± {:.2} | {} |",
                         integrand.name(),
                         f.slope,
                         f.slope_se,
@@ -186,7 +307,7 @@ pub fn run(spec_path: &std::path::Path, text: &str, out: &std::path::Path) -> Re
                     let _ = writeln!(csv, "{pattern},{},,,{t}", integrand.name());
                     let _ = writeln!(
                         md,
-                        "| {pattern} | {} | (no fit: zero error) | {t} |",
+                        "| {pattern} | {sides_text} | {} | (no fit: zero error) | {t} |",
                         integrand.name()
                     );
                 }
@@ -194,10 +315,10 @@ pub fn run(spec_path: &std::path::Path, text: &str, out: &std::path::Path) -> Re
             series.push(Series {
                 label: pattern.to_string(),
                 band: Band {
-                    lo: errors.clone(),
-                    hi: errors.clone(),
-                    mean: errors,
-                    x: ns,
+                    lo: curve.errors.clone(),
+                    hi: curve.errors.clone(),
+                    mean: curve.errors.clone(),
+                    x: curve.ns.clone(),
                 },
             });
         }
@@ -213,9 +334,19 @@ pub fn run(spec_path: &std::path::Path, text: &str, out: &std::path::Path) -> Re
     let _ = writeln!(
         md,
         "\nTheory: for the disk (a discontinuity along a curve), random and Poisson disk N⁻¹, \
-         jittered, CCVT and scrambled Sobol' N⁻¹·⁵ (Pilleboue et al. 2015); the regular grid \
-         is deterministic (its error follows the grid's alignment with the edge). For the \
-         smooth integrand jittered sampling reaches N⁻² in 2D and Owen-scrambled Sobol' N⁻³.\n\n\
+         jittered, CCVT, scrambled Sobol' and the randomly translated regular grid N⁻¹·⁵ \
+         (Pilleboue et al. 2015). For the smooth integrand (not translated, so the regular \
+         grid is deterministic there) jittered sampling reaches N⁻² in 2D and Owen-scrambled \
+         Sobol' N⁻³.\n\n\
+         Poisson disk reaches its N⁻¹ only slowly: dart throwing leaves a small low-frequency \
+         plateau in its spectrum (≈ 0.06 of white noise at the minimum distance used here); \
+         its N⁻¹ term overtakes a steeper N⁻¹·⁵ term only above N ≈ 130, and the local slope \
+         is still −1.14 between N = 512 and 1024 (a fit over N = 16 … 1024 gives about \
+         −1.25). Fitting the later half of the point counts keeps N ≥ 1024 for it. The \
+         randomly translated regular grid's error oscillates with N (the disk's radius \
+         against the grid spacing), so its slope depends on which N are sampled. Sobol' \
+         points form complete nets only when N is a power of two (here N = 4ʲ, the dips on \
+         the smooth plot), so its smooth fit is not a rate.\n\n\
          ![smooth](smooth.png)\n\n![disk](disk.png)"
     );
     write_file_atomically(&out.join("summary.csv"), csv.as_bytes())?;
