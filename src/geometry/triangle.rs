@@ -246,10 +246,21 @@ fn finish(
     }
     let zs = z.map(|v| v * r.sz);
     let t_num = (e[0] * zs[0] + e[1] * zs[1]) + e[2] * zs[2];
-    hit_from(tri, r, t_num, det, *e, t_max)
+    let e_copy = *e;
+    hit_from(tri, r, t_num, det, e_copy, t_max, || {
+        let max_abs = |v: [f32; 3]| v[0].abs().max(v[1].abs()).max(v[2].abs());
+        t_num_error_bound(
+            max_abs(x).max(max_abs(y)),
+            max_abs(z),
+            max_abs(e_copy),
+            r.sz,
+        )
+    })
 }
 
-/// Accepts the candidate: t = T/det within (0, t_max), the sign of t confirmed in f64.
+/// Accepts the candidate: t = T/det within (0, t_max). The sign of t is certain when T
+/// exceeds its rounding error bound (`error_bound()`, evaluated only for candidates);
+/// otherwise it is decided in f64 (`t_is_positive`).
 #[inline(always)]
 fn hit_from(
     tri: &TriangleRecord,
@@ -258,6 +269,7 @@ fn hit_from(
     det: f32,
     e: [f32; 3],
     t_max: f32,
+    error_bound: impl FnOnce() -> f32,
 ) -> Option<TriangleHit> {
     // Make the determinant positive: t = T/det with both signs flipped.
     let (t_num_p, det_p) = if det < 0.0 {
@@ -265,11 +277,35 @@ fn hit_from(
     } else {
         (t_num, det)
     };
-    if !(t_num_p > 0.0 && t_num_p < t_max * det_p && t_is_positive(tri, r)) {
+    if !(t_num_p > 0.0 && t_num_p < t_max * det_p) {
+        return None;
+    }
+    if t_num_p <= error_bound() && !t_is_positive(tri, r) {
         return None;
     }
     let t = t_num_p / det_p;
     (t < t_max).then_some(TriangleHit { t, e, det })
+}
+
+/// A bound on the rounding error of the computed T = Σ e_i·z_i·sz, from the largest sheared
+/// |x|, |y| (`max_xy`), unscaled |z| (`max_z`) and edge function |e| (`max_e`) of the
+/// triangle: the running error analysis of Pharr, Jakob & Humphreys, "Physically Based
+/// Rendering" (3rd ed. §3.9.6, 4th ed. §6.8.6), redone for this test's order of operations:
+/// - x = (v_x − o_x) − s_x·z: s_x = d_x·(1/d_z) carries γ(2), |s_x| ≤ 1 (z is the largest
+///   direction component), so |Δx|, |Δy| ≤ γ(6)·(max_xy + 2·max_z) (one γ to spare);
+/// - e = x_j·y_k − y_j·x_k: |Δe| ≤ 2·(γ(2)·max_xy² + |Δy|·max_xy + |Δx|·max_xy);
+/// - z_s = (v_z − o_z)·s_z: |Δz_s| ≤ γ(3)·max|z_s|, and |z_s| ≤ max_z·|s_z|·(1 + γ(2));
+/// - T, three products summed: |ΔT| ≤ 3·(γ(3)·max_e·max|z_s| + |Δe|·max|z_s| + |Δz_s|·max_e).
+///
+/// Doubled, to cover the rounding of this bound itself and the second-order terms. When
+/// T > bound, the exact T has the computed sign: t > 0 without the f64 test.
+#[inline(always)]
+fn t_num_error_bound(max_xy: f32, max_z: f32, max_e: f32, sz: f32) -> f32 {
+    let max_zs = max_z * sz.abs() * (1.0 + gamma(2));
+    let delta_xy = gamma(6) * (max_xy + 2.0 * max_z);
+    let delta_e = 2.0 * (gamma(2) * max_xy * max_xy + 2.0 * delta_xy * max_xy);
+    let delta_zs = gamma(3) * max_zs;
+    2.0 * 3.0 * (gamma(3) * max_e * max_zs + delta_e * max_zs + delta_zs * max_e)
 }
 
 /// The test with 4-wide SSE arithmetic (one lane per vertex); same results as
@@ -337,7 +373,17 @@ pub fn intersect(tri: &TriangleRecord, r: &TriangleRay, t_max: f32) -> Option<Tr
         let zs = _mm_mul_ps(z, _mm_set1_ps(r.sz));
         let t_num = hsum(_mm_and_ps(_mm_mul_ps(e, zs), lanes012));
         let ev = lanes(e);
-        hit_from(tri, r, t_num, det, [ev[0], ev[1], ev[2]], t_max)
+        hit_from(tri, r, t_num, det, [ev[0], ev[1], ev[2]], t_max, || {
+            // Largest |lane| of lanes 0-2 (lane 3 holds identity bits, not a vertex).
+            let abs012 = _mm_castsi128_ps(_mm_set_epi32(0, 0x7fff_ffff, 0x7fff_ffff, 0x7fff_ffff));
+            let hmax = |v: __m128| -> f32 {
+                let v = _mm_and_ps(v, abs012);
+                let m = _mm_max_ps(v, _mm_shuffle_ps::<0b10_11_00_01>(v, v));
+                _mm_cvtss_f32(_mm_max_ss(m, _mm_movehl_ps(m, m)))
+            };
+            let xy = _mm_max_ps(_mm_and_ps(x, abs012), _mm_and_ps(y, abs012));
+            t_num_error_bound(hmax(xy), hmax(z), hmax(e), r.sz)
+        })
     }
 }
 
@@ -398,6 +444,67 @@ mod tests {
             hits += a.is_some() as u32;
         }
         assert!(hits > 1000);
+    }
+
+    #[test]
+    fn error_bound_never_accepts_a_hit_behind_the_origin() {
+        // Origins on or within a few ulps of the triangle's plane (where rounding decides
+        // the sign of t), at several scales and distances from the world origin: every hit
+        // the test reports must lie at exact t > 0 (the f64 plane-side test agrees), and
+        // far from the plane the bound must let most hits skip that test.
+        let mut s = 0x1234_5678_9abc_def1u64;
+        let (mut hits, mut near_hits, mut skipped) = (0u32, 0u32, 0u32);
+        for i in 0..400_000u32 {
+            let scale = [1e-3f32, 1.0, 1e3, 1e5][(i % 4) as usize];
+            let shift = Vec3::splat([0.0f32, 1.0, 100.0][(i % 3) as usize]) * scale;
+            let v = |s: &mut u64| (Vec3::new(rng(s), rng(s), rng(s)) * 2.0 - 1.0) * scale;
+            let tri_v = [v(&mut s) + shift, v(&mut s) + shift, v(&mut s) + shift];
+            let tri = TriangleRecord::new(tri_v, 0, i);
+            let near_plane = i % 2 == 0;
+            let o = if near_plane {
+                // A point of the plane (barycentrics outside [0,1] too), nudged a few ulps.
+                let (b1, b2) = (rng(&mut s) * 3.0 - 1.0, rng(&mut s) * 3.0 - 1.0);
+                let p = tri_v[0] + (tri_v[1] - tri_v[0]) * b1 + (tri_v[2] - tri_v[0]) * b2;
+                let k = (rng(&mut s) * 7.0) as i32 - 3;
+                p.to_array()
+                    .map(|c| f32::from_bits((c.to_bits() as i32 + k) as u32))
+                    .into()
+            } else {
+                v(&mut s) * 3.0 + shift
+            };
+            let d = v(&mut s);
+            if d.length_squared() == 0.0 {
+                continue;
+            }
+            let r = TriangleRay::new(o, d);
+            if let Some(h) = intersect(&tri, &r, f32::INFINITY) {
+                hits += 1;
+                near_hits += near_plane as u32;
+                assert!(
+                    t_is_positive(&tri, &r),
+                    "hit behind the origin: {o} {d} {h:?}"
+                );
+                let t_num_p = h.t * h.det.abs();
+                let max_abs = |v: [f32; 3]| v[0].abs().max(v[1].abs()).max(v[2].abs());
+                let bound = t_num_error_bound(
+                    max_abs([0, 1, 2].map(|j| tri.rows[r.kx][j] - r.ox))
+                        .max(max_abs([0, 1, 2].map(|j| tri.rows[r.ky][j] - r.oy))),
+                    max_abs([0, 1, 2].map(|j| tri.rows[r.kz][j] - r.oz)),
+                    max_abs(h.e),
+                    r.sz,
+                );
+                skipped += (!near_plane && t_num_p > bound * 1.01) as u32;
+            }
+        }
+        assert!(
+            near_hits > 2_000,
+            "{near_hits} hits from origins near the plane"
+        );
+        assert!(
+            skipped as f64 > 0.9 * (hits - near_hits) as f64,
+            "the bound let {skipped} of {} hits skip the f64 test",
+            hits - near_hits
+        );
     }
 
     #[test]
