@@ -138,7 +138,7 @@ impl TriangleBvh {
             (hitmask & 0xff00_0000) | node.imask as u32,
         );
         s.tri_group = uvec2(node.primitive_base_idx, hitmask & 0x00ff_ffff);
-        self.prefetch_children(node, hitmask, oct);
+        self.prefetch_children::<true>(node, hitmask, oct);
         true
     }
 }
