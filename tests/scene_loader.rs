@@ -151,7 +151,7 @@ fn translate_and_scale_accept_value_forms() {
 fn rotate_is_right_handed_in_degrees() {
     for op in [
         r#"<rotate z="1" angle="90"/>"#,
-        r#"<rotate value="0, 0, 2" angle="90"/>"#,
+        r#"<rotate value="0, 0, 1" angle="90"/>"#,
     ] {
         let desc = load_ok(
             "rotate_z",
@@ -175,6 +175,23 @@ fn rotate_is_right_handed_in_degrees() {
         Vec3::Z,
         TOL
     ));
+}
+
+#[test]
+fn rotate_keeps_a_non_unit_axis_as_mitsuba_does() {
+    // Mitsuba 3.9.1 loads a rectangle under <rotate x="2" angle="90"/> with the bounding box
+    // x ∈ [−4, 4], z ∈ [−2, 2] (Rodrigues' formula on the unnormalised axis): (x, y, 0) goes
+    // to (4x, 0, 2y).
+    let desc = load_ok(
+        "rotate_non_unit",
+        &scene(
+            r#"<shape type="disk"><transform name="to_world"><rotate x="2" angle="90"/></transform></shape>"#,
+        ),
+    );
+    let m = disk_matrix(&desc);
+    assert!(approx_v(m.transform_vector3(Vec3::X), Vec3::X * 4.0, TOL));
+    assert!(approx_v(m.transform_vector3(Vec3::Y), Vec3::Z * 2.0, TOL));
+    assert!(approx_v(m.transform_vector3(Vec3::Z), Vec3::Y * -2.0, TOL));
 }
 
 #[test]

@@ -20,8 +20,7 @@ pub(super) fn parse_transform(tree: &Tree, elem: ElemId) -> Result<Transform> {
                 if axis.length_squared() == 0.0 || !axis.is_finite() {
                     return Err(tree.error(op, "rotation axis must not be zero"));
                 }
-                // Right-handed rotation by `angle` degrees about the axis.
-                Mat4::from_axis_angle(axis.normalize(), angle.to_radians())
+                rotation_as_mitsuba(axis, angle.to_radians())
             }
             "matrix" => {
                 let v = parse_floats(
@@ -54,6 +53,21 @@ pub(super) fn parse_transform(tree: &Tree, elem: ElemId) -> Result<Transform> {
             "transform is singular (e.g. a zero scale) or not finite",
         )
     })
+}
+
+/// Right-handed rotation by `angle` radians about `axis`, by Rodrigues' formula
+/// R = cos θ·I + (1 − cos θ)·a·aᵀ + sin θ·[a]× applied to the axis as written: Mitsuba 3
+/// does not normalise it either, so a non-unit axis also scales (`<rotate x="2" .../>`
+/// stretches x by 4 at 90°), and scenes load to the same matrices in both renderers.
+fn rotation_as_mitsuba(a: Vec3, angle: f32) -> Mat4 {
+    let (s, c) = angle.sin_cos();
+    let cross = Mat3::from_cols(
+        Vec3::new(0.0, a.z, -a.y),
+        Vec3::new(-a.z, 0.0, a.x),
+        Vec3::new(a.y, -a.x, 0.0),
+    );
+    let outer = Mat3::from_cols(a * a.x, a * a.y, a * a.z);
+    Mat4::from_mat3(Mat3::IDENTITY * c + outer * (1.0 - c) + cross * s)
 }
 
 /// Mitsuba's look-at camera frame: the camera looks down +z from `origin` towards `target`;
