@@ -23,6 +23,8 @@ pub struct Distribution1D {
     cdf: Vec<f64>,
     /// Σ func (the integral of the step function over [0, 1) is sum / n).
     sum: f64,
+    /// pmf[i] = func[i] / sum, rounded once to f32 (looked up by every light sample).
+    pmf: Vec<f32>,
 }
 
 impl Distribution1D {
@@ -49,6 +51,7 @@ impl Distribution1D {
             func: weights.to_vec(),
             cdf,
             sum: acc,
+            pmf: weights.iter().map(|&w| (w as f64 / acc) as f32).collect(),
         })
     }
 
@@ -102,11 +105,7 @@ impl Distribution1D {
 
     /// Probability of item `i`.
     pub fn pmf(&self, i: usize) -> f32 {
-        if i < self.func.len() {
-            (self.func[i] as f64 / self.sum) as f32
-        } else {
-            0.0
-        }
+        self.pmf.get(i).copied().unwrap_or(0.0)
     }
 
     /// Draws x in [0, 1) with the step density: (x, density at x, interval index).
