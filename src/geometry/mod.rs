@@ -196,12 +196,14 @@ enum Hit {
 /// The query ray with its direction scaled by a power of two so that its largest
 /// component lies in [1, 2): exactly the same ray (the scaling is exact), with slab
 /// reciprocals that cannot overflow whatever |d| the caller used. Distances t_s along it
-/// convert back exactly: t = t_s / scale.
+/// convert back exactly: t = t_s / scale = t_s · inv_scale.
 #[derive(Clone, Copy)]
 struct ScaledRay {
     o: Vec3,
     d: Vec3,
     scale: f32,
+    /// 1 / scale (a power of two too).
+    inv_scale: f32,
     t_max: f32,
 }
 
@@ -215,11 +217,15 @@ impl ScaledRay {
         }
         // 2^e for the binary exponent e of m (clamped so that 2^±e are normal f32).
         let e = ((m.to_bits() >> 23) & 0xff) as i32 - 127;
-        let scale = f32::from_bits(((127 + e.clamp(-126, 126)) as u32) << 23);
+        let e = e.clamp(-126, 126);
+        let scale = f32::from_bits(((127 + e) as u32) << 23);
+        // d / 2^e as a product with 2^−e (exact, the same value, no division).
+        let inv_scale = f32::from_bits(((127 - e) as u32) << 23);
         Some(ScaledRay {
             o: ray.o,
-            d: ray.d / scale,
+            d: ray.d * inv_scale,
             scale,
+            inv_scale,
             t_max: ray.t_max * scale,
         })
     }
@@ -386,7 +392,7 @@ impl Geometry {
     #[inline(always)]
     fn hit_interaction(&self, hit: Hit, r: &ScaledRay) -> SurfaceInteraction {
         match hit {
-            Hit::Triangle { record, hit } => self.triangle_interaction(record, &hit, r.scale),
+            Hit::Triangle { record, hit } => self.triangle_interaction(record, &hit, r.inv_scale),
             Hit::Sphere { index, t } => {
                 let s = &self.spheres[index];
                 let h = s.hit(r.o, r.d, t);
@@ -439,7 +445,12 @@ impl Geometry {
     }
 
     #[inline(always)]
-    fn triangle_interaction(&self, record: u32, h: &TriangleHit, scale: f32) -> SurfaceInteraction {
+    fn triangle_interaction(
+        &self,
+        record: u32,
+        h: &TriangleHit,
+        inv_scale: f32,
+    ) -> SurfaceInteraction {
         let rec = self.bvh.record(record);
         let v = [rec.vertex(0), rec.vertex(1), rec.vertex(2)];
         let b = h.barycentrics();
@@ -457,7 +468,7 @@ impl Geometry {
             .uvs(record)
             .map(|uv| uv[0] * b[0] + uv[1] * b[1] + uv[2] * b[2])
             .unwrap_or(Vec2::new(b[1], b[2]));
-        interaction(p, p_error, h.t / scale, ng, ns, uv, shape, primitive)
+        interaction(p, p_error, h.t * inv_scale, ng, ns, uv, shape, primitive)
     }
 }
 
