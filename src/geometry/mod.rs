@@ -2,6 +2,8 @@
 //!
 //! - `bvh.rs`: the compressed 8-wide BVH over every triangle of every mesh, and its
 //!   conservative traversal (closest hit and any hit).
+//! - `bvh/stream.rs`: closest hits for a slice of rays with several traversals in flight
+//!   (`Geometry::intersect_stream`), for scenes too large for the cache.
 //! - `cwbvh.rs`: collapsing obvhs's binary BVH into the 8-wide one.
 //! - `triangle.rs`: the watertight ray/triangle test and the hit point's error bound.
 //! - `sphere.rs`, `disk.rs`: analytic shapes, tested one by one in f64.
