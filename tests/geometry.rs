@@ -520,7 +520,7 @@ fn mesh_attributes_are_interpolated() {
         + Vec3::new(0.0, 1.0, 1.0).normalize() * b2)
         .normalize();
     assert!((si.ns - n).length() < 1e-5 && si.ng == Vec3::Z);
-    assert!((si.frame.n - si.ns).length() < 1e-6);
+    assert!((si.frame().n - si.ns).length() < 1e-6);
     // No attributes: barycentric uv, ns = ng.
     let si = g
         .intersect(&Ray::new(Vec3::new(0.25, 0.5, -0.5), -Vec3::Z))

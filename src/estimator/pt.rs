@@ -27,7 +27,7 @@ use crate::error::Result;
 use crate::geometry::{Ray, SurfaceInteraction};
 use crate::light::LightPoint;
 use crate::material::{Bsdf, TransportMode};
-use crate::math::Rgb;
+use crate::math::{Frame, Rgb};
 use crate::path::mis::power_heuristic;
 use crate::sampler::Sampler;
 use crate::sampler::pixel_samples::CameraSampler;
@@ -109,6 +109,7 @@ impl PathSample {
         &self,
         scene: &Scene,
         si: &SurfaceInteraction,
+        frame: &Frame,
         bsdf: &Bsdf,
         wo: Vec3,
         sampler: &mut CameraSampler,
@@ -121,7 +122,7 @@ impl PathSample {
         let Some(ls) = scene.lights.get(index).sample_li(si.p, u) else {
             return (Rgb::BLACK, 0);
         };
-        let wi = si.frame.to_local(ls.wi);
+        let wi = frame.to_local(ls.wi);
         let f = bsdf.eval(wo, wi, TransportMode::Radiance) * wi.z.abs();
         if f.is_black() {
             return (Rgb::BLACK, 0);
@@ -193,11 +194,13 @@ impl CameraSampleFn for PathSample {
             }
 
             let bsdf = scene.bsdf_of_shape(si.shape);
-            let wo = si.frame.to_local(wo_world);
+            let frame = si.frame();
+            let wo = frame.to_local(wo_world);
 
             // Next-event estimation (a path of depth + 2 segments).
             if bsdf.has_non_delta() {
-                let (contribution, shadow_rays) = self.sample_light(scene, &si, bsdf, wo, sampler);
+                let (contribution, shadow_rays) =
+                    self.sample_light(scene, &si, &frame, bsdf, wo, sampler);
                 result += throughput * contribution;
                 rays += shadow_rays;
             }
@@ -215,7 +218,7 @@ impl CameraSampleFn for PathSample {
                 bsdf_pdf: bs.pdf,
                 specular: bs.delta,
             };
-            ray = si.spawn_ray(si.frame.to_world(bs.wi));
+            ray = si.spawn_ray(frame.to_world(bs.wi));
             depth += 1;
 
             // Russian roulette.

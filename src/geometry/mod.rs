@@ -88,8 +88,6 @@ pub struct SurfaceInteraction {
     /// Shading normal (unit): the interpolated vertex normal as it is (possibly on the other
     /// side of `ng`, as in Mitsuba), or `ng` when there are no vertex normals.
     pub ns: Vec3,
-    /// Shading frame around `ns` (`Frame::from_normal(ns)`).
-    pub frame: Frame,
     /// Mesh uvs interpolated, or the barycentrics (b1, b2) when the mesh has none; Mitsuba's
     /// spherical (φ/2π, θ/π) on spheres and polar (r, φ/2π) on disks.
     pub uv: Vec2,
@@ -100,6 +98,12 @@ pub struct SurfaceInteraction {
 }
 
 impl SurfaceInteraction {
+    /// The shading frame around `ns` (`Frame::from_normal(ns)`), built on demand: a query
+    /// that only needs the hit (a shadow test, a photon's first bounce) does not pay for it.
+    pub fn frame(&self) -> Frame {
+        Frame::from_normal(self.ns)
+    }
+
     /// A ray leaving the surface in direction `d`, origin offset to the side `d` points to.
     pub fn spawn_ray(&self, d: Vec3) -> Ray {
         Ray::new(offset_ray_origin(self.p, self.p_error, self.ng, d), d)
@@ -588,7 +592,6 @@ fn interaction(
         t,
         ng,
         ns,
-        frame: Frame::from_normal(ns),
         uv,
         shape,
         primitive,
