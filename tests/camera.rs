@@ -2,6 +2,10 @@
 //! camera space looks down +z with +y up; a camera-space point (x, y, z) lands at
 //! u = ½ − x / (2 z tan(fov_x/2)), v = ½ − aspect · y / (2 z tan(fov_x/2)), raster = (u W, v H).
 
+mod camera_support;
+
+use camera_support::assert_matches_recorded_ray;
+
 use glam::{Mat4, Vec2, Vec3};
 use mltbench::camera::{Camera, horizontal_fov_degrees, raster_in_pixel};
 use mltbench::math::Transform;
@@ -498,20 +502,6 @@ fn matches_rays_recorded_from_mitsuba_3() {
         s.far_clip = 500.0;
         let ray = Camera::new(&s).generate_ray(Vec2::new(x, y));
         let what = format!("case {case} raster ({x}, {y})");
-        assert!(
-            (ray.d - Vec3::from(d)).length() < 2e-6,
-            "{what}: d {} vs {d:?}",
-            ray.d
-        );
-        assert!(
-            (ray.o - Vec3::from(o)).length() < 2e-6,
-            "{what}: o {} vs {o:?}",
-            ray.o
-        );
-        assert!(
-            (ray.t_max / maxt - 1.0).abs() < 1e-5,
-            "{what}: t_max {} vs {maxt}",
-            ray.t_max
-        );
+        assert_matches_recorded_ray(&ray, o, d, maxt, &what);
     }
 }

@@ -2,18 +2,18 @@
 //! second 2D sample of each pixel sample keeps the pattern's structure within each pixel, is
 //! paired with the pixel positions at random, and a pinhole camera never draws it.
 
-use std::path::Path;
+mod eyelight_support;
+
+use eyelight_support::{eyelight, shipped_scene};
+
 use std::sync::Arc;
 
 use glam::Vec2;
-use mltbench::estimator::{self, Params};
 use mltbench::experiment::metrics::metrics;
-use mltbench::image::Image;
-use mltbench::render::{Budget, render};
 use mltbench::sampler::pattern::{Pattern, cell_index, grid_side, points, toroidal_distance};
 use mltbench::sampler::pixel_samples::{CameraSampler, PixelSamples};
 use mltbench::sampler::{IndependentSampler, Sampler, poisson};
-use mltbench::scene::{Scene, mitsuba};
+use mltbench::scene::Scene;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 const SEED: u64 = 77;
@@ -217,16 +217,7 @@ fn sobol_lens_samples_are_dimensions_two_and_three_of_the_same_points() {
 }
 
 fn dof_scene() -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/scenes/cbox-dof.xml");
-    let params = [("res".to_string(), "32".to_string())];
-    Scene::build(mitsuba::load_file_with(&path, &params).unwrap()).unwrap()
-}
-
-fn eyelight(scene: &Scene, sampler: &str, spp: u32, seed: u64) -> Image {
-    let params =
-        Params::parse(&[format!("sampler={sampler}"), format!("sampler_size={spp}")]).unwrap();
-    let mut est = estimator::create("eyelight", &params, scene, seed).unwrap();
-    render(scene, est.as_mut(), Budget::Passes(spp), |_, _| {}).image
+    shipped_scene("cbox-dof.xml", 32)
 }
 
 #[test]

@@ -2,25 +2,16 @@
 //! randomness is where a sample falls in its pixel, structured patterns must converge to
 //! the same image as independent offsets, with less error at equal spp on the edges.
 
-use std::path::Path;
+mod eyelight_support;
+
+use eyelight_support::{eyelight, shipped_scene};
 
 use mltbench::estimator::{self, Params};
 use mltbench::experiment::metrics::metrics;
-use mltbench::image::Image;
-use mltbench::render::{Budget, render};
-use mltbench::scene::{Scene, mitsuba};
+use mltbench::scene::Scene;
 
 fn scene() -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/scenes/cbox.xml");
-    let params = [("res".to_string(), "32".to_string())];
-    Scene::build(mitsuba::load_file_with(&path, &params).unwrap()).unwrap()
-}
-
-fn eyelight(scene: &Scene, sampler: &str, spp: u32, seed: u64) -> Image {
-    let params =
-        Params::parse(&[format!("sampler={sampler}"), format!("sampler_size={spp}")]).unwrap();
-    let mut est = estimator::create("eyelight", &params, scene, seed).unwrap();
-    render(scene, est.as_mut(), Budget::Passes(spp), |_, _| {}).image
+    shipped_scene("cbox.xml", 32)
 }
 
 #[test]

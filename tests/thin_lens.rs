@@ -2,6 +2,10 @@
 //! radius r on the camera plane z = 0, the lens point r · concentric(u), rays from it through
 //! the point the pinhole sees on the focus plane z = F, clipped to [near, far] in camera z.
 
+mod camera_support;
+
+use camera_support::assert_matches_recorded_ray;
+
 use glam::{Mat4, Vec2, Vec3};
 use mltbench::camera::Camera;
 use mltbench::math::Transform;
@@ -422,20 +426,6 @@ fn matches_rays_recorded_from_mitsuba_3() {
         );
         let ray = Camera::new(&s).sample_ray(Vec2::new(x, y), Vec2::from(u));
         let what = format!("case {case} raster ({x}, {y}) lens {u:?}");
-        assert!(
-            (ray.d - Vec3::from(d)).length() < 2e-6,
-            "{what}: d {} vs {d:?}",
-            ray.d
-        );
-        assert!(
-            (ray.o - Vec3::from(o)).length() < 2e-6,
-            "{what}: o {} vs {o:?}",
-            ray.o
-        );
-        assert!(
-            (ray.t_max / maxt - 1.0).abs() < 1e-5,
-            "{what}: t_max {} vs {maxt}",
-            ray.t_max
-        );
+        assert_matches_recorded_ray(&ray, o, d, maxt, &what);
     }
 }
