@@ -4,7 +4,7 @@
 
 mod camera_support;
 
-use camera_support::assert_matches_recorded_ray;
+use camera_support::{assert_matches_recorded_ray, lookat};
 
 use glam::{Mat4, Vec2, Vec3};
 use mltbench::camera::{Camera, horizontal_fov_degrees, raster_in_pixel};
@@ -12,20 +12,6 @@ use mltbench::math::Transform;
 use mltbench::scene::{FilmDesc, FilterDesc, FovAxis, SensorDesc};
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
-
-/// Mitsuba's `lookat`: columns (left, up, dir, origin) with left = up × dir.
-fn lookat(origin: Vec3, target: Vec3, up: Vec3) -> Transform {
-    let dir = (target - origin).normalize();
-    let left = up.normalize().cross(dir).normalize();
-    let new_up = dir.cross(left);
-    Transform::new(Mat4::from_cols(
-        left.extend(0.0),
-        new_up.extend(0.0),
-        dir.extend(0.0),
-        origin.extend(1.0),
-    ))
-    .unwrap()
-}
 
 fn sensor(to_world: Transform, fov: f32, axis: FovAxis, width: u32, height: u32) -> SensorDesc {
     SensorDesc {

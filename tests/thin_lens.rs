@@ -4,29 +4,15 @@
 
 mod camera_support;
 
-use camera_support::assert_matches_recorded_ray;
+use camera_support::{assert_matches_recorded_ray, lookat};
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use mltbench::camera::Camera;
 use mltbench::math::Transform;
 use mltbench::scene::{FilmDesc, FilterDesc, FovAxis, SensorDesc, ThinLensDesc};
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 use statrs::distribution::{ChiSquared, ContinuousCDF};
-
-/// Mitsuba's `lookat`: columns (left, up, dir, origin) with left = up × dir.
-fn lookat(origin: Vec3, target: Vec3, up: Vec3) -> Transform {
-    let dir = (target - origin).normalize();
-    let left = up.normalize().cross(dir).normalize();
-    let new_up = dir.cross(left);
-    Transform::new(Mat4::from_cols(
-        left.extend(0.0),
-        new_up.extend(0.0),
-        dir.extend(0.0),
-        origin.extend(1.0),
-    ))
-    .unwrap()
-}
 
 #[allow(clippy::too_many_arguments)]
 fn sensor(
