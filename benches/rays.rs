@@ -1,7 +1,8 @@
-//! Ray casting throughput: closest-hit queries (`Geometry::intersect`, full surface data)
-//! per second on one and two threads, coherent camera rays and incoherent rays, one query
-//! per ray and as a stream (`Geometry::intersect_stream`, several traversals in flight), plus the
-//! any-hit query and the build time, on two scenes:
+//! Ray casting throughput: closest-hit queries per second, with full surface data
+//! (`Geometry::intersect`) and from the kernel alone (`Geometry::closest_hit`: distance and
+//! surface ids, what a ray-casting kernel reports), on one and two threads, coherent camera
+//! rays and incoherent rays, one query per ray and as a stream (`Geometry::intersect_stream`,
+//! several traversals in flight), plus the any-hit query and the build time, on two scenes:
 //! 1. the Cornell box (556 units) with a ~100k-triangle UV sphere,
 //! 2. a smooth displaced sphere of ~1M triangles.
 //!
@@ -75,17 +76,23 @@ fn incoherent_rays(geometry: &Geometry, count: usize, seed: u64) -> Vec<Ray> {
         .collect()
 }
 
-fn trace_all(pool: &rayon::ThreadPool, geometry: &Geometry, rays: &[Ray]) -> usize {
+/// How many of `rays` `hits` says hit something, the rays split over the pool's threads.
+fn count_hits(pool: &rayon::ThreadPool, rays: &[Ray], hits: impl Fn(&Ray) -> bool + Sync) -> usize {
     pool.install(|| {
         rays.par_chunks(CHUNK)
-            .map(|chunk| {
-                chunk
-                    .iter()
-                    .filter(|r| black_box(geometry.intersect(r)).is_some())
-                    .count()
-            })
+            .map(|chunk| chunk.iter().filter(|r| hits(r)).count())
             .sum()
     })
+}
+
+/// Closest hits with their surface data (`Geometry::intersect`).
+fn trace_all(pool: &rayon::ThreadPool, geometry: &Geometry, rays: &[Ray]) -> usize {
+    count_hits(pool, rays, |r| black_box(geometry.intersect(r)).is_some())
+}
+
+/// Closest hits from the kernel alone (`Geometry::closest_hit`: distance and surface ids).
+fn trace_kernel(pool: &rayon::ThreadPool, geometry: &Geometry, rays: &[Ray]) -> usize {
+    count_hits(pool, rays, |r| black_box(geometry.closest_hit(r)).is_some())
 }
 
 /// `trace_all` through `Geometry::intersect_stream` (several traversals in flight).
@@ -101,16 +108,7 @@ fn trace_stream(pool: &rayon::ThreadPool, geometry: &Geometry, rays: &[Ray]) -> 
 }
 
 fn occluded_all(pool: &rayon::ThreadPool, geometry: &Geometry, rays: &[Ray]) -> usize {
-    pool.install(|| {
-        rays.par_chunks(CHUNK)
-            .map(|chunk| {
-                chunk
-                    .iter()
-                    .filter(|r| black_box(geometry.occluded(r)))
-                    .count()
-            })
-            .sum()
-    })
+    count_hits(pool, rays, |r| black_box(geometry.occluded(r)))
 }
 
 struct BenchScene {
@@ -169,6 +167,12 @@ fn bench_rays(c: &mut Criterion) {
             });
             group.bench_function(format!("closest_incoherent/{threads}t"), |b| {
                 b.iter(|| trace_all(pool, &geometry, &incoherent))
+            });
+            group.bench_function(format!("kernel_coherent/{threads}t"), |b| {
+                b.iter(|| trace_kernel(pool, &geometry, &coherent))
+            });
+            group.bench_function(format!("kernel_incoherent/{threads}t"), |b| {
+                b.iter(|| trace_kernel(pool, &geometry, &incoherent))
             });
             group.bench_function(format!("stream_coherent/{threads}t"), |b| {
                 b.iter(|| trace_stream(pool, &geometry, &coherent))

@@ -168,6 +168,13 @@ fn bvh_agrees_with_brute_force() {
         let ray = Ray::new(o, d);
         let reference = brute_force(&tris, o, d, f64::INFINITY);
         let found = geometry.intersect(&ray);
+        // The kernel query reports the same surface and distance as the full one.
+        let kernel = geometry.closest_hit(&ray);
+        assert_eq!(
+            kernel.map(|k| (k.t, k.shape, k.primitive)),
+            found.map(|f| (f.t, f.shape, f.primitive)),
+            "ray {i}: closest_hit and intersect disagree"
+        );
         match (&reference, &found) {
             (Some(r), Some(f)) => {
                 hits += 1;
@@ -448,6 +455,18 @@ fn closest_hit_across_shape_kinds() {
         disk_shape(disk, false),
     ];
     let g = Geometry::build(&shapes);
+    // The kernel query alone: (shape, t) from the closed forms (sphere at x = 3 − 1, disk at
+    // x = 6 reached with |d| = 2, triangle wall at x = 10).
+    for (ray, shape, t) in [
+        (Ray::new(Vec3::ZERO, Vec3::X), 1, 2.0),
+        (Ray::new(Vec3::new(4.5, 0.0, 0.0), Vec3::X * 2.0), 2, 0.75),
+        (Ray::new(Vec3::new(7.0, 0.0, 0.0), Vec3::X), 0, 3.0),
+    ] {
+        let hit = g.closest_hit(&ray).unwrap();
+        assert_eq!((hit.shape, hit.primitive), (shape, 0));
+        assert!((hit.t - t).abs() < 1e-6, "shape {shape}: t = {}", hit.t);
+        assert_eq!(g.interaction(&hit).t, hit.t);
+    }
     let o = Vec3::ZERO;
     let si = g.intersect(&Ray::new(o, Vec3::X)).unwrap();
     assert_eq!(si.shape, 1);

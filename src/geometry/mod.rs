@@ -199,6 +199,20 @@ enum Hit {
     },
 }
 
+/// The closest hit of a ray as the kernel finds it (`Geometry::closest_hit`): the distance
+/// and the surface, plus what `Geometry::interaction` needs to compute its surface data.
+#[derive(Clone, Copy)]
+pub struct ClosestHit {
+    /// Ray parameter of the hit (in units of the query ray's `d`), as in `SurfaceInteraction`.
+    pub t: f32,
+    /// Index of the shape in `SceneDescription::shapes`.
+    pub shape: u32,
+    /// Triangle index within the shape (0 for analytic shapes).
+    pub primitive: u32,
+    hit: Hit,
+    ray: ScaledRay,
+}
+
 /// The query ray with its direction scaled by a power of two so that its largest
 /// component lies in [1, 2): exactly the same ray (the scaling is exact), with slab
 /// reciprocals that cannot overflow whatever |d| the caller used. Distances t_s along it
@@ -328,14 +342,46 @@ impl Geometry {
         (self.skipped_shapes, self.skipped_triangles)
     }
 
-    /// Closest hit along the ray, if any, with t < ray.t_max.
+    /// Closest hit along the ray, if any, with t < ray.t_max, with its surface data:
+    /// `closest_hit` followed by `interaction`.
+    #[inline]
     pub fn intersect(&self, ray: &Ray) -> Option<SurfaceInteraction> {
+        self.closest_hit(ray).map(|h| self.interaction(&h))
+    }
+
+    /// The ray-casting kernel alone: which surface the ray hits first (t < ray.t_max) and
+    /// where along the ray, without the surface data. For a query that needs only the
+    /// distance or the shape; `interaction` completes it.
+    #[inline]
+    pub fn closest_hit(&self, ray: &Ray) -> Option<ClosestHit> {
         let r = ScaledRay::new(ray)?;
         let (mut hit, t_max) = self.closest_analytic(&r);
         if let Some((record, h)) = self.bvh.closest(&TraversalRay::new(r.o, r.d), t_max) {
             hit = Some(Hit::Triangle { record, hit: h });
         }
-        Some(self.hit_interaction(hit?, &r))
+        let hit = hit?;
+        let (t, [shape, primitive]) = match hit {
+            Hit::Triangle { record, hit } => (hit.t * r.inv_scale, self.bvh.record(record).ids()),
+            Hit::Sphere { index, t } => {
+                ((t / r.scale as f64) as f32, [self.spheres[index].shape, 0])
+            }
+            Hit::Disk { index, t, .. } => {
+                ((t / r.scale as f64) as f32, [self.disks[index].shape, 0])
+            }
+        };
+        Some(ClosestHit {
+            t,
+            shape,
+            primitive,
+            hit,
+            ray: r,
+        })
+    }
+
+    /// The surface data of a hit that `closest_hit` found (the same as `intersect` returns).
+    #[inline]
+    pub fn interaction(&self, hit: &ClosestHit) -> SurfaceInteraction {
+        self.hit_interaction(hit.hit, &hit.ray)
     }
 
     /// `out[i] = self.intersect(&rays[i])` for every ray, with several BVH traversals in
