@@ -12,6 +12,9 @@ use glam::Vec2;
 /// The largest f32 below one: sampled positions stay in [0, 1).
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
+/// Up to this many items `find` counts instead of searching.
+const SMALL: usize = 16;
+
 /// A piecewise-constant density on [0, 1) with `n` equal intervals, proportional to the
 /// weights it was built from; equally the discrete distribution with probabilities
 /// weight_i / Σ weight.
@@ -82,9 +85,15 @@ impl Distribution1D {
     /// The item whose cdf interval [cdf[i], cdf[i+1]) holds `u`. Never an item of weight 0
     /// (its interval is empty).
     fn find(&self, u: f64) -> usize {
-        // Largest i with cdf[i] <= u, among 0..n.
+        // Largest i with cdf[i] <= u, among 0..n: the number of cdf entries <= u, minus one
+        // (the cdf does not decrease). A few items (a light's triangles, a scene's lights)
+        // are counted without branches: a binary search there mispredicts half its steps.
         let n = self.func.len();
-        let i = self.cdf.partition_point(|&c| c <= u);
+        let i = if n <= SMALL {
+            self.cdf.iter().map(|&c| (c <= u) as usize).sum()
+        } else {
+            self.cdf.partition_point(|&c| c <= u)
+        };
         i.saturating_sub(1).min(n - 1)
     }
 
