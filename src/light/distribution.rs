@@ -245,6 +245,25 @@ mod tests {
     }
 
     #[test]
+    fn counted_and_searched_items_agree() {
+        // Sizes on both sides of SMALL, zero weights included: every u lands in the interval
+        // [cdf[i], cdf[i+1]) of the item drawn, and never on an item of weight 0.
+        for n in 1..=2 * SMALL + 1 {
+            let weights: Vec<f32> = (0..n).map(|k| ((k * 7 + 3) % 5) as f32).collect();
+            let Some(d) = Distribution1D::new(&weights) else {
+                continue;
+            };
+            for j in 0..=1000 {
+                let u = j as f32 / 1000.0;
+                let (i, pmf, _) = d.sample_discrete(u);
+                let uc = (u.clamp(0.0, ONE_MINUS_EPSILON)) as f64;
+                assert!(d.cdf[i] <= uc && uc < d.cdf[i + 1], "n {n}, u {u}: item {i}");
+                assert!(pmf > 0.0 && weights[i] > 0.0, "n {n}, u {u}: item {i} of weight 0");
+            }
+        }
+    }
+
+    #[test]
     fn bad_weights_give_none() {
         assert!(Distribution1D::new(&[]).is_none());
         assert!(Distribution1D::new(&[0.0, 0.0]).is_none());
