@@ -43,6 +43,7 @@ pub mod conductor;
 pub mod dielectric;
 pub mod diffuse;
 pub mod fresnel;
+mod glossy_mix;
 pub mod microfacet;
 pub mod null;
 pub mod phong;
@@ -346,8 +347,6 @@ pub fn reflect_about(w: Vec3, m: Vec3) -> Vec3 {
     2.0 * w.dot(m) * m - w
 }
 
-/// A weight that must be finite and non-negative, or the sample is dropped.
-#[inline]
 /// Completes a sampled reflection direction `wi` of a non-delta, reflection-only model:
 /// its pdf, and the weight f·cos θi/pdf; None below the surface or for a degenerate pdf.
 pub(crate) fn reflection_sample(
@@ -373,6 +372,8 @@ pub(crate) fn reflection_sample(
     })
 }
 
+/// A weight that must be finite and non-negative, or the sample is dropped.
+#[inline]
 pub(crate) fn valid_weight(w: Rgb) -> bool {
     w.is_valid_radiance()
 }

@@ -10,13 +10,10 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::material::glossy_mix::{diffuse_plus_glossy, mixture_pdf, sample_mixture};
 use crate::material::plastic::lobe_weight;
-use crate::material::{
-    BsdfFlags, BsdfModel, BsdfSample, TransportMode, reflect_z, reflection_sample, valid_weight,
-};
-use crate::math::warp::{
-    cosine_hemisphere_pdf, cosine_power_pdf, square_to_cosine_hemisphere, square_to_cosine_power,
-};
+use crate::material::{BsdfFlags, BsdfModel, BsdfSample, TransportMode, reflect_z};
+use crate::math::warp::{cosine_power_pdf, square_to_cosine_power};
 use crate::math::{Frame, INV_PI, Rgb};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -60,37 +57,27 @@ impl BsdfModel for Phong {
         } else {
             0.0
         };
-        let value = self.diffuse_reflectance * INV_PI + self.specular_reflectance * spec;
-        if valid_weight(value) {
-            value
-        } else {
-            Rgb::BLACK
-        }
+        diffuse_plus_glossy(self.diffuse_reflectance, self.specular_reflectance, spec)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
-        let ps = self.specular_weight;
         let c = Self::cos_alpha(wo, wi);
         let lobe = cosine_power_pdf(Vec3::new(0.0, 0.0, c), self.exponent);
-        ps * lobe + (1.0 - ps) * cosine_hemisphere_pdf(wi)
+        mixture_pdf(self.specular_weight, lobe, wi)
     }
 
     fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
-        if wo.z <= 0.0 || !wo.is_finite() {
-            return None;
-        }
-        let wi = if u_lobe < self.specular_weight {
+        sample_mixture(self, wo, u_lobe, u, mode, self.specular_weight, |u| {
             let local = square_to_cosine_power(u, self.exponent);
-            Frame::from_normal(reflect_z(wo))
-                .to_world(local)
-                .normalize_or_zero()
-        } else {
-            square_to_cosine_hemisphere(u)
-        };
-        reflection_sample(self, wo, wi, mode)
+            Some(
+                Frame::from_normal(reflect_z(wo))
+                    .to_world(local)
+                    .normalize_or_zero(),
+            )
+        })
     }
 
     fn flags(&self) -> BsdfFlags {

@@ -22,14 +22,14 @@
 use glam::{Vec2, Vec3};
 
 use crate::material::fresnel::{fresnel_dielectric, refract_about};
+use crate::material::glossy_mix::sample_mixture;
 use crate::material::microfacet::beckmann_visible_slopes;
 use crate::material::plastic::{internal_scattering, lobe_weight};
 use crate::material::quadrature::gauss_legendre;
 use crate::material::{
-    BsdfFlags, BsdfModel, BsdfSample, Microfacet, TransportMode, reflect_about, reflection_sample,
-    valid_weight,
+    BsdfFlags, BsdfModel, BsdfSample, Microfacet, TransportMode, reflect_about, valid_weight,
 };
-use crate::math::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
+use crate::math::warp::cosine_hemisphere_pdf;
 use crate::math::{INV_PI, Rgb};
 use crate::scene::MicrofacetKind;
 
@@ -164,16 +164,10 @@ impl BsdfModel for RoughPlastic {
             return None;
         }
         let (ps, _) = self.lobe_probabilities(self.external_transmittance(wo.z));
-        let wi = if u_lobe < ps {
+        sample_mixture(self, wo, u_lobe, u, mode, ps, |u| {
             let (m, pdf_m) = self.distribution.sample_normal(wo, u);
-            if pdf_m <= 0.0 {
-                return None;
-            }
-            reflect_about(wo, m).normalize_or_zero()
-        } else {
-            square_to_cosine_hemisphere(u)
-        };
-        reflection_sample(self, wo, wi, mode)
+            (pdf_m > 0.0).then(|| reflect_about(wo, m).normalize_or_zero())
+        })
     }
 
     fn flags(&self) -> BsdfFlags {

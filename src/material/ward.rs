@@ -10,12 +10,13 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::material::plastic::lobe_weight;
-use crate::material::{
-    BsdfFlags, BsdfModel, BsdfSample, TransportMode, reflect_about, reflection_sample, valid_weight,
+use crate::material::glossy_mix::{
+    diffuse_plus_glossy, half_vector_pdf_to_wi, mixture_pdf, reflect_about_half_vector,
+    sample_mixture,
 };
-use crate::math::warp::{cosine_hemisphere_pdf, square_to_cosine_hemisphere};
-use crate::math::{INV_PI, PI, Rgb};
+use crate::material::plastic::lobe_weight;
+use crate::material::{BsdfFlags, BsdfModel, BsdfSample, TransportMode};
+use crate::math::{PI, Rgb};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct Ward {
@@ -79,45 +80,21 @@ impl BsdfModel for Ward {
         } else {
             0.0
         };
-        let value = self.diffuse_reflectance * INV_PI + self.specular_reflectance * spec;
-        if valid_weight(value) {
-            value
-        } else {
-            Rgb::BLACK
-        }
+        diffuse_plus_glossy(self.diffuse_reflectance, self.specular_reflectance, spec)
     }
 
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
         }
-        let ps = self.specular_weight;
-        let mut p = (1.0 - ps) * cosine_hemisphere_pdf(wi);
-        let h = (wo + wi).normalize_or_zero();
-        let wo_h = wo.dot(h);
-        if h.z > 0.0 && wo_h > 0.0 {
-            let spec = self.half_vector_pdf(h) / (4.0 * wo_h);
-            if spec.is_finite() {
-                p += ps * spec;
-            }
-        }
-        p
+        let lobe = half_vector_pdf_to_wi(wo, wi, |h| self.half_vector_pdf(h));
+        mixture_pdf(self.specular_weight, lobe, wi)
     }
 
     fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
-        if wo.z <= 0.0 || !wo.is_finite() {
-            return None;
-        }
-        let wi = if u_lobe < self.specular_weight {
-            let h = self.sample_half_vector(u);
-            if wo.dot(h) <= 0.0 {
-                return None;
-            }
-            reflect_about(wo, h).normalize_or_zero()
-        } else {
-            square_to_cosine_hemisphere(u)
-        };
-        reflection_sample(self, wo, wi, mode)
+        sample_mixture(self, wo, u_lobe, u, mode, self.specular_weight, |u| {
+            reflect_about_half_vector(wo, self.sample_half_vector(u))
+        })
     }
 
     fn flags(&self) -> BsdfFlags {
