@@ -240,55 +240,40 @@ impl TriangleBvh {
     /// Closest triangle with 0 < t < t_max: (record index, its hit data).
     #[inline(always)]
     pub fn closest(&self, ray: &TraversalRay, t_max: f32) -> Option<(u32, TriangleHit)> {
-        if self.nodes.is_empty() {
-            return None;
-        }
         let mut visitor = Closest {
             bvh: self,
             ray,
             best: None,
         };
-        let mut t_max = t_max;
-        if self.depth < FIXED_STACK {
-            self.traverse(
-                ray,
-                &mut t_max,
-                &mut FixedStack::<FIXED_STACK>::new(),
-                &mut visitor,
-            );
-        } else {
-            self.traverse(
-                ray,
-                &mut t_max,
-                &mut Vec::with_capacity(self.depth + 1),
-                &mut visitor,
-            );
-        }
+        self.traverse_from_root(ray, t_max, &mut visitor);
         visitor.best
     }
 
     /// True when some triangle lies at 0 < t < t_max.
     #[inline(always)]
     pub fn any(&self, ray: &TraversalRay, t_max: f32) -> bool {
+        self.traverse_from_root(ray, t_max, &mut Any { bvh: self, ray })
+    }
+
+    /// `traverse` over the whole tree (false for an empty one), with its stack on the call
+    /// frame when the tree is shallow enough for `FIXED_STACK` entries, on the heap otherwise.
+    #[inline(always)]
+    fn traverse_from_root(
+        &self,
+        ray: &TraversalRay,
+        t_max: f32,
+        visitor: &mut impl Visitor,
+    ) -> bool {
         if self.nodes.is_empty() {
             return false;
         }
-        let mut visitor = Any { bvh: self, ray };
         let mut t_max = t_max;
         if self.depth < FIXED_STACK {
-            self.traverse(
-                ray,
-                &mut t_max,
-                &mut FixedStack::<FIXED_STACK>::new(),
-                &mut visitor,
-            )
+            let mut stack = FixedStack::<FIXED_STACK>::new();
+            self.traverse(ray, &mut t_max, &mut stack, visitor)
         } else {
-            self.traverse(
-                ray,
-                &mut t_max,
-                &mut Vec::with_capacity(self.depth + 1),
-                &mut visitor,
-            )
+            let mut stack = Vec::with_capacity(self.depth + 1);
+            self.traverse(ray, &mut t_max, &mut stack, visitor)
         }
     }
 

@@ -4,6 +4,7 @@
 
 use glam::{DMat4, DVec3, Mat4, Vec2, Vec3};
 
+use super::AnalyticHit;
 use super::offset::gamma;
 use crate::math::Transform;
 
@@ -18,15 +19,6 @@ pub struct Disk {
     /// Unit normal: the local +z through the inverse transpose, negated by `flip_normals`.
     pub n: Vec3,
     pub shape: u32,
-}
-
-/// Surface data at a disk hit.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct DiskHit {
-    pub p: Vec3,
-    pub p_error: Vec3,
-    pub n: Vec3,
-    pub uv: Vec2,
 }
 
 impl Disk {
@@ -73,7 +65,7 @@ impl Disk {
     /// on the disk's plane up to f64 error (a few 2⁻⁵³ of Σ|M_ij·q_j|), then rounded to f32
     /// (u·|p|): bound γ(2)·|p| + 2⁻⁴⁶·Σ|M_ij·q_j|. uv as Mitsuba's disk: (r, φ/2π) with
     /// φ = atan2(y, x) in [0, 2π).
-    pub fn hit(&self, local: [f64; 2]) -> DiskHit {
+    pub fn hit(&self, local: [f64; 2]) -> AnalyticHit {
         let [x, y] = local;
         let p64 = self.to_world64.transform_point3(DVec3::new(x, y, 0.0));
         let p = p64.as_vec3();
@@ -86,7 +78,7 @@ impl Disk {
         if v < 0.0 {
             v += 1.0;
         }
-        DiskHit {
+        AnalyticHit {
             p,
             p_error,
             n: self.n,

@@ -199,6 +199,24 @@ enum Hit {
     },
 }
 
+/// Surface data at a hit on an analytic shape (sphere or disk).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct AnalyticHit {
+    pub p: Vec3,
+    pub p_error: Vec3,
+    /// Unit normal: outward on spheres, the local +z on disks; negated by `flip_normals`.
+    pub n: Vec3,
+    pub uv: Vec2,
+}
+
+/// The interaction at analytic hit `h` of shape `shape`, found at t (in the scaled ray's
+/// units) along `r`. Analytic shapes have no separate shading normal.
+#[inline(always)]
+fn analytic_interaction(h: AnalyticHit, t: f64, r: &ScaledRay, shape: u32) -> SurfaceInteraction {
+    let t = (t / r.scale as f64) as f32;
+    interaction(h.p, h.p_error, t, h.n, h.n, h.uv, shape, 0)
+}
+
 /// The closest hit of a ray as the kernel finds it (`Geometry::closest_hit`): the distance
 /// and the surface, plus what `Geometry::interaction` needs to compute its surface data.
 #[derive(Clone, Copy)]
@@ -447,31 +465,11 @@ impl Geometry {
             Hit::Triangle { record, hit } => self.triangle_interaction(record, &hit, r.inv_scale),
             Hit::Sphere { index, t } => {
                 let s = &self.spheres[index];
-                let h = s.hit(r.o, r.d, t);
-                interaction(
-                    h.p,
-                    h.p_error,
-                    (t / r.scale as f64) as f32,
-                    h.n,
-                    h.n,
-                    h.uv,
-                    s.shape,
-                    0,
-                )
+                analytic_interaction(s.hit(r.o, r.d, t), t, r, s.shape)
             }
             Hit::Disk { index, t, local } => {
                 let d = &self.disks[index];
-                let h = d.hit(local);
-                interaction(
-                    h.p,
-                    h.p_error,
-                    (t / r.scale as f64) as f32,
-                    h.n,
-                    h.n,
-                    h.uv,
-                    d.shape,
-                    0,
-                )
+                analytic_interaction(d.hit(local), t, r, d.shape)
             }
         }
     }

@@ -6,6 +6,7 @@
 
 use glam::{DVec3, Vec2, Vec3};
 
+use super::AnalyticHit;
 use super::offset::gamma;
 
 /// A sphere of `flip_normals` orientation, belonging to shape `shape`.
@@ -15,16 +16,6 @@ pub struct Sphere {
     pub radius: f32,
     pub flip_normals: bool,
     pub shape: u32,
-}
-
-/// Surface data at a sphere hit.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct SphereHit {
-    pub p: Vec3,
-    pub p_error: Vec3,
-    /// Unit normal, outward unless `flip_normals`.
-    pub n: Vec3,
-    pub uv: Vec2,
 }
 
 impl Sphere {
@@ -75,7 +66,7 @@ impl Sphere {
     /// errors are the f64 ones (a few 2⁻⁵³ of |c| + r) and the final rounding to f32 (u·|p|
     /// per coordinate). The bound is γ(2)·|p| + 2⁻⁴⁶·(|c| + r): generous on both counts.
     /// uv as Mitsuba's sphere: u = φ/2π with φ = atan2(y, x) in [0, 2π), v = θ/π from +z.
-    pub fn hit(&self, o: Vec3, d: Vec3, t: f64) -> SphereHit {
+    pub fn hit(&self, o: Vec3, d: Vec3, t: f64) -> AnalyticHit {
         let c = self.center.as_dvec3();
         let h = o.as_dvec3() + d.as_dvec3() * t;
         let mut n = h - c;
@@ -95,7 +86,7 @@ impl Sphere {
             (theta / std::f64::consts::PI) as f32,
         );
         let n = n.as_vec3().normalize();
-        SphereHit {
+        AnalyticHit {
             p,
             p_error,
             n: if self.flip_normals { -n } else { n },

@@ -257,8 +257,14 @@ mod tests {
                 let u = j as f32 / 1000.0;
                 let (i, pmf, _) = d.sample_discrete(u);
                 let uc = (u.clamp(0.0, ONE_MINUS_EPSILON)) as f64;
-                assert!(d.cdf[i] <= uc && uc < d.cdf[i + 1], "n {n}, u {u}: item {i}");
-                assert!(pmf > 0.0 && weights[i] > 0.0, "n {n}, u {u}: item {i} of weight 0");
+                assert!(
+                    d.cdf[i] <= uc && uc < d.cdf[i + 1],
+                    "n {n}, u {u}: item {i}"
+                );
+                assert!(
+                    pmf > 0.0 && weights[i] > 0.0,
+                    "n {n}, u {u}: item {i} of weight 0"
+                );
             }
         }
     }

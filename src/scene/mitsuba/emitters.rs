@@ -165,17 +165,9 @@ impl Builder<'_> {
             return Err(tree.error(props.owner(), "an envmap emitter needs a \"filename\""));
         };
         let named_at = props.elem_of("filename");
-        let (found, searched) = tree.resolve_file(filename, tree.elem(named_at).file);
-        let Some(path) = found else {
-            let list: Vec<String> = searched.iter().map(|p| p.display().to_string()).collect();
-            return Err(tree.error(
-                named_at,
-                format!(
-                    "environment map \"{filename}\" not found (searched: {})",
-                    list.join(", ")
-                ),
-            ));
-        };
+        let path = tree
+            .find_file(filename, tree.elem(named_at).file, "environment map")
+            .map_err(|message| tree.error(named_at, message))?;
         let scale = props.float("scale")?.unwrap_or(1.0);
         if !(scale.is_finite() && scale >= 0.0) {
             return Err(tree.error(

@@ -201,17 +201,9 @@ impl Builder<'_> {
         // Mitsuba flips the v coordinate of OBJ files by default (OBJ's v points up).
         let flip_tex_coords = kind == "obj" && props.boolean("flip_tex_coords")?.unwrap_or(true);
         let named_at = props.elem_of("filename");
-        let (found, searched) = tree.resolve_file(filename, tree.elem(named_at).file);
-        let Some(path) = found else {
-            let list: Vec<String> = searched.iter().map(|p| p.display().to_string()).collect();
-            return Err(tree.error(
-                named_at,
-                format!(
-                    "mesh file \"{filename}\" not found (searched: {})",
-                    list.join(", ")
-                ),
-            ));
-        };
+        let path = tree
+            .find_file(filename, tree.elem(named_at).file, "mesh file")
+            .map_err(|message| tree.error(named_at, message))?;
         self.note_file(path.clone());
         let mut mesh = if kind == "obj" {
             read_obj(&path)

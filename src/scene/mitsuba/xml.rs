@@ -176,6 +176,24 @@ impl Tree {
         Err(self.error(asked_by, format!("reference to unknown id \"{id}\"")))
     }
 
+    /// `resolve_file`, or the message for a file that does not exist:
+    /// `{what} "{name}" not found (searched: …)`, every place looked at listed.
+    pub fn find_file(
+        &self,
+        name: &str,
+        named_in: FileId,
+        what: &str,
+    ) -> std::result::Result<PathBuf, String> {
+        let (found, searched) = self.resolve_file(name, named_in);
+        found.ok_or_else(|| {
+            let list: Vec<String> = searched.iter().map(|p| p.display().to_string()).collect();
+            format!(
+                "{what} \"{name}\" not found (searched: {})",
+                list.join(", ")
+            )
+        })
+    }
+
     /// Looks a relative file name up: the `<path>` folders first (most recent first, as
     /// Mitsuba's file resolver does), then the folder of the file that names it, then the
     /// scene file's folder. Absolute names are taken as they are. None when nothing exists.
@@ -636,17 +654,10 @@ impl Reader {
         parent_kind: Kind,
         location: impl Fn() -> Location,
     ) -> Result<()> {
-        let (found, searched) = self.tree.resolve_file(filename, file);
-        let Some(path) = found else {
-            let list: Vec<String> = searched.iter().map(|p| p.display().to_string()).collect();
-            return Err(Error::input(
-                location(),
-                format!(
-                    "included file \"{filename}\" not found (searched: {})",
-                    list.join(", ")
-                ),
-            ));
-        };
+        let path = self
+            .tree
+            .find_file(filename, file, "included file")
+            .map_err(|message| Error::input(location(), message))?;
         let canonical = path.canonicalize().unwrap_or_else(|_| path.clone());
         if self
             .include_stack
