@@ -58,6 +58,11 @@ fn shape_desc(name: &str, geometry: ShapeGeometry, flip_normals: bool) -> ShapeD
     }
 }
 
+/// A sphere shape (Mitsuba's `sphere`: centre and radius, normals out unless flipped).
+fn sphere_shape(name: &str, center: Vec3, radius: f32, flip_normals: bool) -> ShapeDesc {
+    shape_desc(name, ShapeGeometry::Sphere { center, radius }, flip_normals)
+}
+
 fn mesh(positions: &[Vec3], indices: &[[u32; 3]]) -> TriangleMesh {
     TriangleMesh {
         positions: positions.to_vec(),
@@ -535,19 +540,7 @@ fn li_cases() -> Vec<LiCase> {
         });
     }
     let c = Vec3::new(0.5, -0.25, 1.0);
-    let sphere = |flip| {
-        area_light(
-            shape_desc(
-                "sphere",
-                ShapeGeometry::Sphere {
-                    center: c,
-                    radius: 1.0,
-                },
-                flip,
-            ),
-            white,
-        )
-    };
+    let sphere = |flip| area_light(sphere_shape("sphere", c, 1.0, flip), white);
     let outside = sphere(false);
     for (name, r) in [
         (
@@ -748,17 +741,7 @@ fn lights_seen_from_behind_give_nothing() {
             Vec3::new(0.1, 0.2, -1.0),
         ),
         (
-            area_light(
-                shape_desc(
-                    "s",
-                    ShapeGeometry::Sphere {
-                        center: c,
-                        radius: 1.0,
-                    },
-                    false,
-                ),
-                white,
-            ),
+            area_light(sphere_shape("s", c, 1.0, false), white),
             TestShape::Sphere {
                 c,
                 r: 1.0,
@@ -767,17 +750,7 @@ fn lights_seen_from_behind_give_nothing() {
             Vec3::new(0.2, 0.1, 0.3),
         ),
         (
-            area_light(
-                shape_desc(
-                    "s",
-                    ShapeGeometry::Sphere {
-                        center: c,
-                        radius: 1.0,
-                    },
-                    true,
-                ),
-                white,
-            ),
+            area_light(sphere_shape("s", c, 1.0, true), white),
             TestShape::Sphere {
                 c,
                 r: 1.0,
@@ -808,25 +781,11 @@ fn samples_agree_with_the_ray_caster() {
     let shapes = vec![
         (mesh_shape(&pyramid()), Vec3::new(0.3, 0.2, 2.0)),
         (
-            shape_desc(
-                "s",
-                ShapeGeometry::Sphere {
-                    center: c,
-                    radius: 1.0,
-                },
-                false,
-            ),
+            sphere_shape("s", c, 1.0, false),
             c + Vec3::new(0.0, 2.0, 0.5),
         ),
         (
-            shape_desc(
-                "s",
-                ShapeGeometry::Sphere {
-                    center: c,
-                    radius: 1.0,
-                },
-                true,
-            ),
+            sphere_shape("s", c, 1.0, true),
             c + Vec3::new(0.1, 0.2, 0.3),
         ),
         (
@@ -1028,17 +987,7 @@ fn sample_le_matches_its_distributions() {
 
     // Sphere: uniform over its surface (8 × 8) × cosine about the outward normal (4 × 4).
     let c = Vec3::new(0.5, -0.25, 1.0);
-    let light = area_light(
-        shape_desc(
-            "s",
-            ShapeGeometry::Sphere {
-                center: c,
-                radius: 0.7,
-            },
-            false,
-        ),
-        radiance,
-    );
+    let light = area_light(sphere_shape("s", c, 0.7, false), radiance);
     let expect = vec![1.0 / 1024.0; 1024];
     let bin = |s: &EmissionSample| {
         let out = (s.origin - c).normalize();
@@ -1523,14 +1472,7 @@ fn scratch(test: &str) -> PathBuf {
 
 fn envmap_scene(path: PathBuf) -> SceneDescription {
     scene_of(
-        vec![shape_desc(
-            "ball",
-            ShapeGeometry::Sphere {
-                center: Vec3::ZERO,
-                radius: 1.0,
-            },
-            false,
-        )],
+        vec![sphere_shape("ball", Vec3::ZERO, 1.0, false)],
         vec![EmitterDesc::Envmap {
             filename: path,
             scale: 1.0,
@@ -1701,10 +1643,7 @@ fn rectangle_irradiance_matches_lambert() {
 fn sphere_irradiance_matches_closed_form() {
     let c = Vec3::new(0.2, 0.3, -0.1);
     let (radius, l) = (0.5f32, 2.0f64);
-    let light = area_light(
-        shape_desc("s", ShapeGeometry::Sphere { center: c, radius }, false),
-        Rgb::splat(l as f32),
-    );
+    let light = area_light(sphere_shape("s", c, radius, false), Rgb::splat(l as f32));
     for (k, (d, axis)) in [
         (2.0f32, Vec3::new(0.0, 0.0, 1.0)),
         (0.6, Vec3::new(1.0, -1.0, 0.3).normalize()),
@@ -1841,23 +1780,9 @@ fn selection_is_proportional_to_power() {
     let disk = disk_transform();
     let mut shapes = vec![
         mesh_shape(&quad),
-        shape_desc(
-            "ball",
-            ShapeGeometry::Sphere {
-                center: c,
-                radius: 0.5,
-            },
-            false,
-        ),
+        sphere_shape("ball", c, 0.5, false),
         shape_desc("disk", ShapeGeometry::Disk { to_world: disk }, false),
-        shape_desc(
-            "not emitting",
-            ShapeGeometry::Sphere {
-                center: -c,
-                radius: 1.0,
-            },
-            false,
-        ),
+        sphere_shape("not emitting", -c, 1.0, false),
     ];
     shapes[0].emitter = Some(0);
     shapes[1].emitter = Some(1);
@@ -2014,28 +1939,8 @@ fn degenerate_queries_stay_finite() {
     let lights = vec![
         area_light(mesh_shape(&rectangle()), Rgb::splat(1.0)),
         area_light(mesh_shape(&pyramid()), Rgb::splat(1.0)),
-        area_light(
-            shape_desc(
-                "s",
-                ShapeGeometry::Sphere {
-                    center: c,
-                    radius: 1.0,
-                },
-                false,
-            ),
-            Rgb::splat(1.0),
-        ),
-        area_light(
-            shape_desc(
-                "s",
-                ShapeGeometry::Sphere {
-                    center: c,
-                    radius: 1.0,
-                },
-                true,
-            ),
-            Rgb::splat(1.0),
-        ),
+        area_light(sphere_shape("s", c, 1.0, false), Rgb::splat(1.0)),
+        area_light(sphere_shape("s", c, 1.0, true), Rgb::splat(1.0)),
         area_light(
             shape_desc(
                 "d",
