@@ -17,7 +17,11 @@
 //! Every χ² case draws `N` samples with a fixed seed and is tested at the Šidák-corrected
 //! level for an overall significance of 10⁻³ over the `CHI2_CASES` cases of this file.
 
+mod chi2_support;
+
 use std::path::PathBuf;
+
+use chi2_support::make_bins;
 
 use glam::{DVec3, Mat4, Quat, Vec2, Vec3};
 use mltbench::image::Image;
@@ -350,50 +354,6 @@ impl Grid {
     }
 }
 
-/// Groups the cells of a grid into bins from the expected counts alone (never the observed
-/// ones, so the statistic keeps its distribution): rows into bands of about total/16, each
-/// band cut along its columns into bins of about total/256.
-fn make_bins(grid: &Grid, expected: &[f64], total: f64) -> (Vec<usize>, usize) {
-    let group = |values: &[f64], target: f64| -> Vec<(usize, usize)> {
-        let mut out: Vec<(usize, usize)> = Vec::new();
-        let (mut start, mut acc) = (0, 0.0);
-        for (i, v) in values.iter().enumerate() {
-            acc += v;
-            if acc >= target {
-                out.push((start, i + 1));
-                start = i + 1;
-                acc = 0.0;
-            }
-        }
-        if start < values.len() {
-            match out.last_mut() {
-                Some(last) => last.1 = values.len(),
-                None => out.push((start, values.len())),
-            }
-        }
-        out
-    };
-    let rows: Vec<f64> = (0..grid.na)
-        .map(|i| expected[i * grid.nb..(i + 1) * grid.nb].iter().sum())
-        .collect();
-    let mut bin_of_cell = vec![0; grid.cells()];
-    let mut n_bins = 0;
-    for (r0, r1) in group(&rows, total / 16.0) {
-        let cols: Vec<f64> = (0..grid.nb)
-            .map(|j| (r0..r1).map(|i| expected[i * grid.nb + j]).sum())
-            .collect();
-        for (c0, c1) in group(&cols, total / 256.0) {
-            for i in r0..r1 {
-                for j in c0..c1 {
-                    bin_of_cell[i * grid.nb + j] = n_bins;
-                }
-            }
-            n_bins += 1;
-        }
-    }
-    (bin_of_cell, n_bins)
-}
-
 /// p-value of Pearson's χ² after pooling bins expected to hold fewer than 5 (Cochran's
 /// rule); 0 when draws fall where nothing at all was expected.
 fn chi2_p_value(expected: &[f64], observed: &[f64]) -> f64 {
@@ -632,7 +592,7 @@ fn run_li_case(case: &LiCase, seed: u64, pdf: &(dyn Fn(Vec3) -> f64 + Sync)) -> 
         .map(|p| p * n)
         .collect();
     let mass = cells.iter().sum::<f64>() / n;
-    let (bin_of_cell, n_bins) = make_bins(&case.grid, &cells, n);
+    let (bin_of_cell, n_bins) = make_bins(case.grid.na, case.grid.nb, &cells, n);
     // Bins: the grid's, then "outside the grid" (nothing expected), then "no sample".
     let mut expected = vec![0.0; n_bins + 2];
     for (c, e) in cells.iter().enumerate() {

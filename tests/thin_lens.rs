@@ -3,8 +3,10 @@
 //! the point the pinhole sees on the focus plane z = F, clipped to [near, far] in camera z.
 
 mod camera_support;
+mod chi2_support;
 
 use camera_support::{assert_matches_recorded_ray, lookat};
+use chi2_support::pearson_uniform;
 
 use glam::{Vec2, Vec3};
 use mltbench::camera::Camera;
@@ -12,7 +14,6 @@ use mltbench::math::Transform;
 use mltbench::scene::{FilmDesc, FilterDesc, FovAxis, SensorDesc, ThinLensDesc};
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
-use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 #[allow(clippy::too_many_arguments)]
 fn sensor(
@@ -189,13 +190,7 @@ fn lens_points_are_uniform_on_the_aperture() {
         let sector = ((phi / std::f64::consts::TAU * sectors as f64) as usize).min(sectors - 1);
         counts[ring * sectors + sector] += 1;
     }
-    let expected = n as f64 / counts.len() as f64;
-    let chi2: f64 = counts
-        .iter()
-        .map(|&c| (c as f64 - expected).powi(2) / expected)
-        .sum();
-    let dof = (counts.len() - 1) as f64;
-    let p = 1.0 - ChiSquared::new(dof).unwrap().cdf(chi2);
+    let (chi2, dof, p) = pearson_uniform(&counts, n as f64);
     assert!(p > 1e-3, "χ² = {chi2:.1} with {dof} dof, p = {p:.2e}");
 }
 
