@@ -10,7 +10,11 @@
 //!
 //! Everything uses fixed seeds. Statistical thresholds are stated where they are used.
 
+mod chi2_support;
+
 use std::sync::OnceLock;
+
+use chi2_support::make_bins;
 
 use glam::{Vec2, Vec3};
 use mltbench::material::fresnel::{
@@ -335,66 +339,20 @@ const CHI2_SAMPLES: usize = 100_000;
 /// Overall significance; each case is tested at the Šidák-corrected level.
 const CHI2_ALPHA: f64 = 1e-3;
 
-/// Bins for the χ² test, built from the expected counts only (never from the observed
-/// ones), so the test statistic keeps its distribution. Rows of cells are grouped into
-/// bands holding about 1/16 of the samples each, and each band is cut along φ into bins
-/// holding about 1/256: nearly equiprobable bins that follow peaked lobes down to the cell
-/// size.
-fn make_bins(grid: &SphereQuadrature, expected: &[f64], total: f64) -> (Vec<usize>, usize) {
-    let band_target = total / 16.0;
-    let bin_target = total / 256.0;
-    let row_total: Vec<f64> = (0..grid.n_theta)
-        .map(|i| expected[i * grid.n_phi..(i + 1) * grid.n_phi].iter().sum())
-        .collect();
-    let mut bands: Vec<(usize, usize)> = Vec::new();
-    let (mut start, mut acc) = (0, 0.0);
-    for (i, r) in row_total.iter().enumerate() {
-        acc += r;
-        if acc >= band_target {
-            bands.push((start, i + 1));
-            start = i + 1;
-            acc = 0.0;
-        }
+/// Expected counts of the `n_bins` bins of `make_bins` out of `n` draws, plus a last bin:
+/// the draws that give a delta sample or no sample.
+fn expected_per_bin(
+    expected_cells: &[f64],
+    bin_of_cell: &[usize],
+    n_bins: usize,
+    n: f64,
+) -> Vec<f64> {
+    let mut expected = vec![0.0; n_bins + 1];
+    for (c, e) in expected_cells.iter().enumerate() {
+        expected[bin_of_cell[c]] += e;
     }
-    if start < grid.n_theta {
-        match bands.last_mut() {
-            Some(last) => last.1 = grid.n_theta,
-            None => bands.push((start, grid.n_theta)),
-        }
-    }
-    let mut bin_of_cell = vec![0usize; grid.cells()];
-    let mut n_bins = 0;
-    for (r0, r1) in bands {
-        let col: Vec<f64> = (0..grid.n_phi)
-            .map(|j| (r0..r1).map(|i| expected[i * grid.n_phi + j]).sum())
-            .collect();
-        // Cut points along φ.
-        let mut segments: Vec<(usize, usize)> = Vec::new();
-        let (mut s, mut a) = (0, 0.0);
-        for (j, c) in col.iter().enumerate() {
-            a += c;
-            if a >= bin_target {
-                segments.push((s, j + 1));
-                s = j + 1;
-                a = 0.0;
-            }
-        }
-        if s < grid.n_phi {
-            match segments.last_mut() {
-                Some(last) => last.1 = grid.n_phi,
-                None => segments.push((s, grid.n_phi)),
-            }
-        }
-        for (c0, c1) in segments {
-            for i in r0..r1 {
-                for j in c0..c1 {
-                    bin_of_cell[i * grid.n_phi + j] = n_bins;
-                }
-            }
-            n_bins += 1;
-        }
-    }
-    (bin_of_cell, n_bins)
+    expected[n_bins] = (n - expected[..n_bins].iter().sum::<f64>()).max(0.0);
+    expected
 }
 
 /// χ² statistic and degrees of freedom after pooling bins whose expected count is below 5
@@ -468,13 +426,8 @@ fn chi2_case(name: &str, bsdf: &Bsdf, wo: Vec3, seed: u64) -> Chi2Result {
         .map(|p| p * n)
         .collect();
     let mass: f64 = expected_cells.iter().sum::<f64>() / n;
-    let (bin_of_cell, n_bins) = make_bins(grid, &expected_cells, n);
-    let mut expected = vec![0.0; n_bins + 1];
-    for (c, e) in expected_cells.iter().enumerate() {
-        expected[bin_of_cell[c]] += e;
-    }
-    // The last bin: draws that give a delta sample or no sample.
-    expected[n_bins] = (n - expected[..n_bins].iter().sum::<f64>()).max(0.0);
+    let (bin_of_cell, n_bins) = make_bins(grid.n_theta, grid.n_phi, &expected_cells, n);
+    let expected = expected_per_bin(&expected_cells, &bin_of_cell, n_bins, n);
 
     let mut observed = vec![0.0; n_bins + 1];
     let mut sampler = IndependentSampler::new(seed);
@@ -695,12 +648,8 @@ fn chi2_harness_rejects_wrong_pdfs() {
             .integrate_cells(|wi| claimed.pdf(wo, wi) as f64 * n, 1e-3, 1e-5)
             .into_iter()
             .collect();
-        let (bin_of_cell, n_bins) = make_bins(grid, &expected_cells, n);
-        let mut expected = vec![0.0; n_bins + 1];
-        for (c, e) in expected_cells.iter().enumerate() {
-            expected[bin_of_cell[c]] += e;
-        }
-        expected[n_bins] = (n - expected[..n_bins].iter().sum::<f64>()).max(0.0);
+        let (bin_of_cell, n_bins) = make_bins(grid.n_theta, grid.n_phi, &expected_cells, n);
+        let expected = expected_per_bin(&expected_cells, &bin_of_cell, n_bins, n);
         let mut observed = vec![0.0; n_bins + 1];
         let mut sampler = IndependentSampler::new(5);
         for _ in 0..CHI2_SAMPLES {

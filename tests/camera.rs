@@ -4,7 +4,7 @@
 
 mod camera_support;
 
-use camera_support::{assert_matches_recorded_ray, lookat};
+use camera_support::{RECORDED_SENSORS, assert_matches_recorded_ray, lookat};
 
 use glam::{Mat4, Vec2, Vec3};
 use mltbench::camera::{Camera, horizontal_fov_degrees, raster_in_pixel};
@@ -338,59 +338,10 @@ fn raster_in_pixel_never_rounds_into_the_next_pixel() {
 
 /// Rays recorded from Mitsuba 3.9.1 (`scalar_rgb`): for each sensor, `sensor.sample_ray(0,
 /// 0.5, (x / W, y / H), (0.5, 0.5))` with near_clip 0.05, far_clip 500 and a box-filtered
-/// hdrfilm, printing `ray.o`, `ray.d` and `ray.maxt`. The sensors are
-/// (fov, fov_axis, W, H, lookat origin, target, up).
+/// hdrfilm, printing `ray.o`, `ray.d` and `ray.maxt`. The sensors are `RECORDED_SENSORS`.
 #[test]
 #[allow(clippy::excessive_precision)] // the digits Mitsuba printed
 fn matches_rays_recorded_from_mitsuba_3() {
-    type Case = (f32, FovAxis, u32, u32, [f32; 3], [f32; 3], [f32; 3]);
-    let cases: [Case; 5] = [
-        (
-            90.0,
-            FovAxis::X,
-            200,
-            100,
-            [0.0, 0.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 1.0, 0.0],
-        ),
-        (
-            45.0,
-            FovAxis::Y,
-            64,
-            48,
-            [0.0, 1.0, -4.0],
-            [0.0, 0.5, 0.0],
-            [0.0, 1.0, 0.0],
-        ),
-        (
-            60.0,
-            FovAxis::Diagonal,
-            37,
-            91,
-            [3.0, -2.0, 5.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 1.0, 0.0],
-        ),
-        (
-            30.0,
-            FovAxis::Smaller,
-            200,
-            100,
-            [1.0, 2.0, 3.0],
-            [-1.0, 0.0, 0.0],
-            [0.0, 0.0, 1.0],
-        ),
-        (
-            70.0,
-            FovAxis::Larger,
-            100,
-            200,
-            [1.0, 2.0, 3.0],
-            [-1.0, 0.0, 0.0],
-            [0.3, 1.0, 0.0],
-        ),
-    ];
     // (case, raster x, raster y, o, d, maxt)
     type Record = (usize, f32, f32, [f32; 3], [f32; 3], f32);
     let records: [Record; 10] = [
@@ -476,7 +427,7 @@ fn matches_rays_recorded_from_mitsuba_3() {
         ),
     ];
     for (case, x, y, o, d, maxt) in records {
-        let (fov, axis, w, h, origin, target, up) = cases[case];
+        let (fov, axis, w, h, origin, target, up) = RECORDED_SENSORS[case];
         let mut s = sensor(
             lookat(Vec3::from(origin), Vec3::from(target), Vec3::from(up)),
             fov,

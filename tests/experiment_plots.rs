@@ -4,9 +4,12 @@
 //!
 //! Set `MLTBENCH_PLOT_DIR=/some/dir` to keep the figures for a look.
 
+mod dir_support;
+
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
+use dir_support::listing;
 use mltbench::experiment::plot::{
     Band, Crop, Series, SheetEntry, bias_variance_plot, check_crops, contact_sheet,
     convergence_plot, viridis,
@@ -29,16 +32,6 @@ fn done(dir: &Path) {
     if std::env::var_os("MLTBENCH_PLOT_DIR").is_none() {
         let _ = std::fs::remove_dir_all(dir);
     }
-}
-
-/// The file names in `dir`, sorted: atomic writes leave no temporary file behind.
-fn listing(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
 }
 
 struct Png {

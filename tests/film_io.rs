@@ -1,8 +1,11 @@
 //! Film accumulation (filters, tiles, splats, determinism) and image files (EXR, PNG,
 //! tone mapping, atomic writes).
 
+mod dir_support;
+
 use std::path::{Path, PathBuf};
 
+use dir_support::listing;
 use glam::Vec2;
 use mltbench::Error;
 use mltbench::film::{Film, FilmTile, PixelRect, SplatList};
@@ -26,15 +29,6 @@ fn test_dir(name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
-}
-
-fn dir_entries(dir: &Path) -> Vec<String> {
-    let mut names: Vec<String> = std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .collect();
-    names.sort();
-    names
 }
 
 fn bits(image: &Image) -> Vec<[u32; 3]> {
@@ -427,7 +421,7 @@ fn exr_round_trip_is_bit_exact() {
     }
     // Only the images, no temporary files.
     assert_eq!(
-        dir_entries(&dir),
+        listing(&dir),
         vec!["image_1x1.exr", "image_300x2.exr", "image_37x23.exr"]
     );
 }
@@ -642,7 +636,7 @@ fn png_preview_decodes_to_the_right_size_and_orientation() {
     assert!(buf[3] < 100);
     let last = (w * h * 3) as usize;
     assert!(buf[last - 3] >= buf[last - 6]);
-    assert_eq!(dir_entries(&dir), vec!["preview.png"]);
+    assert_eq!(listing(&dir), vec!["preview.png"]);
 }
 
 // ---------------------------------------------------------------------------------------
@@ -655,7 +649,7 @@ fn atomic_writes_replace_content_and_leave_no_temporary_files() {
     write_file_atomically(&path, b"old").unwrap();
     write_file_atomically(&path, b"new content").unwrap();
     assert_eq!(std::fs::read(&path).unwrap(), b"new content");
-    assert_eq!(dir_entries(&dir), vec!["result.csv"]);
+    assert_eq!(listing(&dir), vec!["result.csv"]);
 
     // A failing writer leaves the old file and no temporary file.
     let failed = write_atomically(&path, |w| {
@@ -665,7 +659,7 @@ fn atomic_writes_replace_content_and_leave_no_temporary_files() {
     });
     assert!(failed.is_err());
     assert_eq!(std::fs::read(&path).unwrap(), b"new content");
-    assert_eq!(dir_entries(&dir), vec!["result.csv"]);
+    assert_eq!(listing(&dir), vec!["result.csv"]);
 
     // A missing directory is an error naming the file.
     let nowhere = dir.join("no_such_dir").join("x.exr");

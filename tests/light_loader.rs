@@ -167,13 +167,11 @@ fn bad_spots_are_errors_naming_the_line() {
         ),
     ] {
         let text = with_sphere(body);
-        let (message, file) = load_err("bad_spot", &text);
-        assert_names(&message, &file, line_of(&text, needle));
+        let message = load_err_at("bad_spot", &text, line_of(&text, needle));
         assert!(message.contains(what), "{message}");
     }
     let text = scene("<shape type=\"sphere\">\n<emitter type=\"spot\"/>\n</shape>");
-    let (message, file) = load_err("spot_on_shape", &text);
-    assert_names(&message, &file, 3);
+    let message = load_err_at("spot_on_shape", &text, 3);
     assert!(message.contains("only area emitters"), "{message}");
 }
 

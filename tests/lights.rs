@@ -17,7 +17,11 @@
 //! Every χ² case draws `N` samples with a fixed seed and is tested at the Šidák-corrected
 //! level for an overall significance of 10⁻³ over the `CHI2_CASES` cases of this file.
 
+mod chi2_support;
+
 use std::path::PathBuf;
+
+use chi2_support::make_bins;
 
 use glam::{DVec3, Mat4, Quat, Vec2, Vec3};
 use mltbench::image::Image;
@@ -56,6 +60,11 @@ fn shape_desc(name: &str, geometry: ShapeGeometry, flip_normals: bool) -> ShapeD
         interior_medium: None,
         exterior_medium: None,
     }
+}
+
+/// A sphere shape (Mitsuba's `sphere`: centre and radius, normals out unless flipped).
+fn sphere_shape(name: &str, center: Vec3, radius: f32, flip_normals: bool) -> ShapeDesc {
+    shape_desc(name, ShapeGeometry::Sphere { center, radius }, flip_normals)
 }
 
 fn mesh(positions: &[Vec3], indices: &[[u32; 3]]) -> TriangleMesh {
@@ -345,50 +354,6 @@ impl Grid {
     }
 }
 
-/// Groups the cells of a grid into bins from the expected counts alone (never the observed
-/// ones, so the statistic keeps its distribution): rows into bands of about total/16, each
-/// band cut along its columns into bins of about total/256.
-fn make_bins(grid: &Grid, expected: &[f64], total: f64) -> (Vec<usize>, usize) {
-    let group = |values: &[f64], target: f64| -> Vec<(usize, usize)> {
-        let mut out: Vec<(usize, usize)> = Vec::new();
-        let (mut start, mut acc) = (0, 0.0);
-        for (i, v) in values.iter().enumerate() {
-            acc += v;
-            if acc >= target {
-                out.push((start, i + 1));
-                start = i + 1;
-                acc = 0.0;
-            }
-        }
-        if start < values.len() {
-            match out.last_mut() {
-                Some(last) => last.1 = values.len(),
-                None => out.push((start, values.len())),
-            }
-        }
-        out
-    };
-    let rows: Vec<f64> = (0..grid.na)
-        .map(|i| expected[i * grid.nb..(i + 1) * grid.nb].iter().sum())
-        .collect();
-    let mut bin_of_cell = vec![0; grid.cells()];
-    let mut n_bins = 0;
-    for (r0, r1) in group(&rows, total / 16.0) {
-        let cols: Vec<f64> = (0..grid.nb)
-            .map(|j| (r0..r1).map(|i| expected[i * grid.nb + j]).sum())
-            .collect();
-        for (c0, c1) in group(&cols, total / 256.0) {
-            for i in r0..r1 {
-                for j in c0..c1 {
-                    bin_of_cell[i * grid.nb + j] = n_bins;
-                }
-            }
-            n_bins += 1;
-        }
-    }
-    (bin_of_cell, n_bins)
-}
-
 /// p-value of Pearson's χ² after pooling bins expected to hold fewer than 5 (Cochran's
 /// rule); 0 when draws fall where nothing at all was expected.
 fn chi2_p_value(expected: &[f64], observed: &[f64]) -> f64 {
@@ -535,19 +500,7 @@ fn li_cases() -> Vec<LiCase> {
         });
     }
     let c = Vec3::new(0.5, -0.25, 1.0);
-    let sphere = |flip| {
-        area_light(
-            shape_desc(
-                "sphere",
-                ShapeGeometry::Sphere {
-                    center: c,
-                    radius: 1.0,
-                },
-                flip,
-            ),
-            white,
-        )
-    };
+    let sphere = |flip| area_light(sphere_shape("sphere", c, 1.0, flip), white);
     let outside = sphere(false);
     for (name, r) in [
         (
@@ -639,7 +592,7 @@ fn run_li_case(case: &LiCase, seed: u64, pdf: &(dyn Fn(Vec3) -> f64 + Sync)) -> 
         .map(|p| p * n)
         .collect();
     let mass = cells.iter().sum::<f64>() / n;
-    let (bin_of_cell, n_bins) = make_bins(&case.grid, &cells, n);
+    let (bin_of_cell, n_bins) = make_bins(case.grid.na, case.grid.nb, &cells, n);
     // Bins: the grid's, then "outside the grid" (nothing expected), then "no sample".
     let mut expected = vec![0.0; n_bins + 2];
     for (c, e) in cells.iter().enumerate() {
@@ -748,17 +701,7 @@ fn lights_seen_from_behind_give_nothing() {
             Vec3::new(0.1, 0.2, -1.0),
         ),
         (
-            area_light(
-                shape_desc(
-                    "s",
-                    ShapeGeometry::Sphere {
-                        center: c,
-                        radius: 1.0,
-                    },
-                    false,
-                ),
-                white,
-            ),
+            area_light(sphere_shape("s", c, 1.0, false), white),
             TestShape::Sphere {
                 c,
                 r: 1.0,
@@ -767,17 +710,7 @@ fn lights_seen_from_behind_give_nothing() {
             Vec3::new(0.2, 0.1, 0.3),
         ),
         (
-            area_light(
-                shape_desc(
-                    "s",
-                    ShapeGeometry::Sphere {
-                        center: c,
-                        radius: 1.0,
-                    },
-                    true,
-                ),
-                white,
-            ),
+            area_light(sphere_shape("s", c, 1.0, true), white),
             TestShape::Sphere {
                 c,
                 r: 1.0,
@@ -808,25 +741,11 @@ fn samples_agree_with_the_ray_caster() {
     let shapes = vec![
         (mesh_shape(&pyramid()), Vec3::new(0.3, 0.2, 2.0)),
         (
-            shape_desc(
-                "s",
-                ShapeGeometry::Sphere {
-                    center: c,
-                    radius: 1.0,
-                },
-                false,
-            ),
+            sphere_shape("s", c, 1.0, false),
             c + Vec3::new(0.0, 2.0, 0.5),
         ),
         (
-            shape_desc(
-                "s",
-                ShapeGeometry::Sphere {
-                    center: c,
-                    radius: 1.0,
-                },
-                true,
-            ),
+            sphere_shape("s", c, 1.0, true),
             c + Vec3::new(0.1, 0.2, 0.3),
         ),
         (
@@ -1028,17 +947,7 @@ fn sample_le_matches_its_distributions() {
 
     // Sphere: uniform over its surface (8 × 8) × cosine about the outward normal (4 × 4).
     let c = Vec3::new(0.5, -0.25, 1.0);
-    let light = area_light(
-        shape_desc(
-            "s",
-            ShapeGeometry::Sphere {
-                center: c,
-                radius: 0.7,
-            },
-            false,
-        ),
-        radiance,
-    );
+    let light = area_light(sphere_shape("s", c, 0.7, false), radiance);
     let expect = vec![1.0 / 1024.0; 1024];
     let bin = |s: &EmissionSample| {
         let out = (s.origin - c).normalize();
@@ -1523,14 +1432,7 @@ fn scratch(test: &str) -> PathBuf {
 
 fn envmap_scene(path: PathBuf) -> SceneDescription {
     scene_of(
-        vec![shape_desc(
-            "ball",
-            ShapeGeometry::Sphere {
-                center: Vec3::ZERO,
-                radius: 1.0,
-            },
-            false,
-        )],
+        vec![sphere_shape("ball", Vec3::ZERO, 1.0, false)],
         vec![EmitterDesc::Envmap {
             filename: path,
             scale: 1.0,
@@ -1701,10 +1603,7 @@ fn rectangle_irradiance_matches_lambert() {
 fn sphere_irradiance_matches_closed_form() {
     let c = Vec3::new(0.2, 0.3, -0.1);
     let (radius, l) = (0.5f32, 2.0f64);
-    let light = area_light(
-        shape_desc("s", ShapeGeometry::Sphere { center: c, radius }, false),
-        Rgb::splat(l as f32),
-    );
+    let light = area_light(sphere_shape("s", c, radius, false), Rgb::splat(l as f32));
     for (k, (d, axis)) in [
         (2.0f32, Vec3::new(0.0, 0.0, 1.0)),
         (0.6, Vec3::new(1.0, -1.0, 0.3).normalize()),
@@ -1841,23 +1740,9 @@ fn selection_is_proportional_to_power() {
     let disk = disk_transform();
     let mut shapes = vec![
         mesh_shape(&quad),
-        shape_desc(
-            "ball",
-            ShapeGeometry::Sphere {
-                center: c,
-                radius: 0.5,
-            },
-            false,
-        ),
+        sphere_shape("ball", c, 0.5, false),
         shape_desc("disk", ShapeGeometry::Disk { to_world: disk }, false),
-        shape_desc(
-            "not emitting",
-            ShapeGeometry::Sphere {
-                center: -c,
-                radius: 1.0,
-            },
-            false,
-        ),
+        sphere_shape("not emitting", -c, 1.0, false),
     ];
     shapes[0].emitter = Some(0);
     shapes[1].emitter = Some(1);
@@ -2014,28 +1899,8 @@ fn degenerate_queries_stay_finite() {
     let lights = vec![
         area_light(mesh_shape(&rectangle()), Rgb::splat(1.0)),
         area_light(mesh_shape(&pyramid()), Rgb::splat(1.0)),
-        area_light(
-            shape_desc(
-                "s",
-                ShapeGeometry::Sphere {
-                    center: c,
-                    radius: 1.0,
-                },
-                false,
-            ),
-            Rgb::splat(1.0),
-        ),
-        area_light(
-            shape_desc(
-                "s",
-                ShapeGeometry::Sphere {
-                    center: c,
-                    radius: 1.0,
-                },
-                true,
-            ),
-            Rgb::splat(1.0),
-        ),
+        area_light(sphere_shape("s", c, 1.0, false), Rgb::splat(1.0)),
+        area_light(sphere_shape("s", c, 1.0, true), Rgb::splat(1.0)),
         area_light(
             shape_desc(
                 "d",

@@ -1509,21 +1509,20 @@ fn wrong_arity() {
     let text = scene(
         "<shape type=\"sphere\">\n<bsdf type=\"diffuse\">\n<rgb name=\"reflectance\" value=\"0.5, 0.5\"/></bsdf></shape>",
     );
-    let (message, file) = load_err("arity_rgb", &text);
-    assert_names(&message, &file, 4);
+    let message = load_err_at("arity_rgb", &text, 4);
     assert!(message.contains("<rgb name=\"reflectance\">"), "{message}");
-    let (message, file) = load_err(
-        "arity_matrix",
-        &scene(
+    for (test, body) in [
+        (
+            "arity_matrix",
             "<shape type=\"disk\"><transform name=\"to_world\">\n<matrix value=\"1 0 0 1\"/></transform></shape>",
         ),
-    );
-    assert_names(&message, &file, 3);
-    let (message, file) = load_err(
-        "arity_point",
-        &scene("<shape type=\"sphere\">\n<point name=\"center\" value=\"1 2\"/></shape>"),
-    );
-    assert_names(&message, &file, 3);
+        (
+            "arity_point",
+            "<shape type=\"sphere\">\n<point name=\"center\" value=\"1 2\"/></shape>",
+        ),
+    ] {
+        load_err_at(test, &scene(body), 3);
+    }
 }
 
 #[test]
@@ -1713,9 +1712,7 @@ fn unsupported_features_say_so() {
             "<medium type=\"homogeneous\" name=\"interior\">",
         ),
     ] {
-        let text = with_sphere(body);
-        let (message, file) = load_err("unsupported", &text);
-        assert_names(&message, &file, 3);
+        let message = load_err_at("unsupported", &with_sphere(body), 3);
         assert!(message.contains("not supported yet"), "{message}");
         assert!(message.contains(element), "{element}: {message}");
     }

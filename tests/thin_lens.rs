@@ -3,8 +3,10 @@
 //! the point the pinhole sees on the focus plane z = F, clipped to [near, far] in camera z.
 
 mod camera_support;
+mod chi2_support;
 
-use camera_support::{assert_matches_recorded_ray, lookat};
+use camera_support::{RECORDED_SENSORS, assert_matches_recorded_ray, lookat};
+use chi2_support::pearson_uniform;
 
 use glam::{Vec2, Vec3};
 use mltbench::camera::Camera;
@@ -12,7 +14,6 @@ use mltbench::math::Transform;
 use mltbench::scene::{FilmDesc, FilterDesc, FovAxis, SensorDesc, ThinLensDesc};
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
-use statrs::distribution::{ChiSquared, ContinuousCDF};
 
 #[allow(clippy::too_many_arguments)]
 fn sensor(
@@ -189,13 +190,7 @@ fn lens_points_are_uniform_on_the_aperture() {
         let sector = ((phi / std::f64::consts::TAU * sectors as f64) as usize).min(sectors - 1);
         counts[ring * sectors + sector] += 1;
     }
-    let expected = n as f64 / counts.len() as f64;
-    let chi2: f64 = counts
-        .iter()
-        .map(|&c| (c as f64 - expected).powi(2) / expected)
-        .sum();
-    let dof = (counts.len() - 1) as f64;
-    let p = 1.0 - ChiSquared::new(dof).unwrap().cdf(chi2);
+    let (chi2, dof, p) = pearson_uniform(&counts, n as f64);
     assert!(p > 1e-3, "χ² = {chi2:.1} with {dof} dof, p = {p:.2e}");
 }
 
@@ -237,57 +232,13 @@ fn connect_lens_inverts_sample_ray() {
 /// Rays recorded from Mitsuba 3.9.1 (`scalar_rgb`): for each sensor,
 /// `sensor.sample_ray(0, 0.5, (x / W, y / H), aperture_sample)` with near_clip 0.05,
 /// far_clip 500 and a box-filtered hdrfilm, printing `ray.o`, `ray.d` and `ray.maxt` (the
-/// weight was 1 in every case). The sensors are (fov, fov_axis, W, H, lookat origin, target,
-/// up, aperture_radius, focus_distance).
+/// weight was 1 in every case). The sensors are the first three of `RECORDED_SENSORS`, each
+/// with a lens.
 #[test]
 #[allow(clippy::excessive_precision)] // the digits Mitsuba printed
 fn matches_rays_recorded_from_mitsuba_3() {
-    type Case = (
-        f32,
-        FovAxis,
-        u32,
-        u32,
-        [f32; 3],
-        [f32; 3],
-        [f32; 3],
-        f32,
-        f32,
-    );
-    let cases: [Case; 3] = [
-        (
-            90.0,
-            FovAxis::X,
-            200,
-            100,
-            [0.0, 0.0, 0.0],
-            [0.0, 0.0, 1.0],
-            [0.0, 1.0, 0.0],
-            0.1,
-            2.0,
-        ),
-        (
-            45.0,
-            FovAxis::Y,
-            64,
-            48,
-            [0.0, 1.0, -4.0],
-            [0.0, 0.5, 0.0],
-            [0.0, 1.0, 0.0],
-            0.25,
-            4.5,
-        ),
-        (
-            60.0,
-            FovAxis::Diagonal,
-            37,
-            91,
-            [3.0, -2.0, 5.0],
-            [0.0, 1.0, 0.0],
-            [0.0, 1.0, 0.0],
-            0.05,
-            0.3,
-        ),
-    ];
+    // (aperture_radius, focus_distance) added to the first three sensors.
+    let lenses: [(f32, f32); 3] = [(0.1, 2.0), (0.25, 4.5), (0.05, 0.3)];
     // (case, raster x, raster y, aperture sample, o, d, maxt)
     type Record = (usize, f32, f32, [f32; 2], [f32; 3], [f32; 3], f32);
     let records: [Record; 12] = [
@@ -401,7 +352,8 @@ fn matches_rays_recorded_from_mitsuba_3() {
         ),
     ];
     for (case, x, y, u, o, d, maxt) in records {
-        let (fov, axis, w, h, origin, target, up, radius, focus) = cases[case];
+        let (fov, axis, w, h, origin, target, up) = RECORDED_SENSORS[case];
+        let (radius, focus) = lenses[case];
         let s = sensor(
             lookat(Vec3::from(origin), Vec3::from(target), Vec3::from(up)),
             fov,

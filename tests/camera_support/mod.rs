@@ -4,6 +4,7 @@
 use glam::{Mat4, Vec3};
 use mltbench::geometry::Ray;
 use mltbench::math::Transform;
+use mltbench::scene::FovAxis;
 
 /// Mitsuba's `lookat`: columns (left, up, dir, origin) with left = up × dir.
 pub fn lookat(origin: Vec3, target: Vec3, up: Vec3) -> Transform {
@@ -38,3 +39,18 @@ pub fn assert_matches_recorded_ray(ray: &Ray, o: [f32; 3], d: [f32; 3], maxt: f3
         ray.t_max
     );
 }
+
+/// A sensor that rays were recorded from in Mitsuba 3.9.1: (fov, fov_axis, W, H, lookat
+/// origin, target, up).
+pub type RecordedSensor = (f32, FovAxis, u32, u32, [f32; 3], [f32; 3], [f32; 3]);
+
+/// The recorded sensors: the pinhole rays use all five, the thin-lens rays the first three
+/// with an aperture and focus distance added.
+#[rustfmt::skip]
+pub const RECORDED_SENSORS: [RecordedSensor; 5] = [
+    (90.0, FovAxis::X, 200, 100, [0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]),
+    (45.0, FovAxis::Y, 64, 48, [0.0, 1.0, -4.0], [0.0, 0.5, 0.0], [0.0, 1.0, 0.0]),
+    (60.0, FovAxis::Diagonal, 37, 91, [3.0, -2.0, 5.0], [0.0, 1.0, 0.0], [0.0, 1.0, 0.0]),
+    (30.0, FovAxis::Smaller, 200, 100, [1.0, 2.0, 3.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
+    (70.0, FovAxis::Larger, 100, 200, [1.0, 2.0, 3.0], [-1.0, 0.0, 0.0], [0.3, 1.0, 0.0]),
+];

@@ -65,6 +65,14 @@ pub fn load_err(test: &str, text: &str) -> (String, PathBuf) {
     }
 }
 
+/// Loads a scene that must fail, asserts the message names the scene file at `line`, and
+/// returns the message.
+pub fn load_err_at(test: &str, text: &str, line: usize) -> String {
+    let (message, file) = load_err(test, text);
+    assert_names(&message, &file, line);
+    message
+}
+
 /// The 1-based line of the first line of `text` containing `needle`.
 pub fn line_of(text: &str, needle: &str) -> usize {
     1 + text
