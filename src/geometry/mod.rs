@@ -1,5 +1,9 @@
 //! Ray casting: all triangles in one BVH (obvhs), analytic shapes beside it.
 //!
+//! Queries on `Geometry`: `closest_hit` (the kernel: which surface, how far),
+//! `interaction` (its surface data), `intersect` (both), `intersect_stream` (`intersect`
+//! for a slice of rays) and `occluded` (any hit, for shadow rays).
+//!
 //! - `bvh.rs`: the compressed 8-wide BVH over every triangle of every mesh, and its
 //!   conservative traversal (closest hit and any hit).
 //! - `bvh/stream.rs`: closest hits for a slice of rays with several traversals in flight
