@@ -61,3 +61,23 @@ fn an_unknown_sampler_is_an_error() {
         "{err}"
     );
 }
+
+#[test]
+fn a_large_sample_count_needs_a_pattern_size_only_for_patterns() {
+    // A reference scene may ask for more spp than the largest pattern has points: fine for
+    // independent samples; a pattern must say which scene asked and how to size it.
+    let mut scene = scene();
+    scene.description.sensor.sample_count = 100_000;
+    assert!(estimator::create("pt", &Params::default(), &scene, 0).is_ok());
+    let params = Params::parse(&["sampler=stratified"]).unwrap();
+    let err = estimator::create("pt", &params, &scene, 0)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(
+        err.contains("cbox.xml") && err.contains("100000") && err.contains("sampler_size"),
+        "{err}"
+    );
+    let params = Params::parse(&["sampler=stratified", "sampler_size=64"]).unwrap();
+    assert!(estimator::create("pt", &params, &scene, 0).is_ok());
+}

@@ -65,6 +65,9 @@ pub fn create(name: &str, params: &Params, scene: &Scene, seed: u64) -> Result<B
     Ok(estimator)
 }
 
+/// The most points a sample pattern may have (`sampler_size`).
+const MAX_PATTERN_SIZE: usize = 1 << 16;
+
 /// The camera estimators' `sampler` (a `sampler::pattern::Pattern` name, default
 /// `independent`) and `sampler_size` (points in the pattern, default the scene's
 /// `<sampler sample_count>`: the spp the pattern is laid out for) parameters.
@@ -73,12 +76,25 @@ fn pixel_samples(params: &Params, scene: &Scene, seed: u64) -> Result<PixelSampl
     let pattern: Pattern = name
         .parse()
         .map_err(|e: String| Error::usage(format!("--set sampler={name}: {e}")))?;
+    let explicit = params.raw("sampler_size").is_some();
     let default_size = scene.description.sensor.sample_count.max(1) as usize;
     let size: usize = params.get("sampler_size", default_size)?;
-    if size == 0 || size > 1 << 16 {
-        return Err(Error::usage(format!(
-            "--set sampler_size={size}: must be between 1 and 65536"
-        )));
+    // Independent samples need no pattern: any spp works.
+    if pattern == Pattern::Independent && !explicit {
+        return Ok(PixelSamples::new(pattern, 1, seed));
+    }
+    if size == 0 || size > MAX_PATTERN_SIZE {
+        return Err(if explicit {
+            Error::usage(format!(
+                "--set sampler_size={size}: must be between 1 and {MAX_PATTERN_SIZE}"
+            ))
+        } else {
+            Error::usage(format!(
+                "{}: the sampler's sample_count {size} is larger than the largest {name} \
+                 pattern ({MAX_PATTERN_SIZE} points); pass --set sampler_size=N",
+                scene.description.source.display()
+            ))
+        });
     }
     Ok(PixelSamples::new(pattern, size, seed))
 }

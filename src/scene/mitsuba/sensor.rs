@@ -253,7 +253,7 @@ impl Builder<'_> {
             Some(n) => {
                 return Err(tree.error(
                     props.elem_of("sample_count"),
-                    format!("sample_count must be at least 1, got {n}"),
+                    format!("sample_count must be between 1 and {}, got {n}", u32::MAX),
                 ));
             }
         };
