@@ -197,37 +197,58 @@ fn cells_run_one_by_one_then_reported_match_a_single_run() {
 fn bad_specs_and_corrupt_results_are_errors_naming_the_file() {
     let dir = temp_dir("bad");
     let good = std::fs::read_to_string(tiny_spec(&dir, "{ passes = 4 }")).unwrap();
+    // (what, text, the text on the line the error must name: a key's line, or the header
+    // of the table the bad entry is in).
     let cases = [
         (
             "unknown key",
             good.replace("runs = 2", "runs = 2\nrunz = 3"),
+            "runz = 3",
         ),
         (
             "unknown estimator",
             good.replace("name = \"eyelight\"", "name = \"nope\""),
+            "[[estimator]]\nname = \"nope\"",
         ),
         (
             "both budgets",
             good.replace("{ passes = 4 }", "{ passes = 4, seconds = 1 }"),
+            "budget = { passes = 4, seconds = 1 }",
         ),
         (
             "duplicate label",
             good.replace("label = \"preview (biased)\"", "label = \"pt\""),
+            "[[estimator]]\nname = \"eyelight\"",
         ),
-        ("no reference", good.replace("budget = { passes = 64 }", "")),
-        ("zero runs", good.replace("runs = 2", "runs = 0")),
+        (
+            "no reference",
+            good.replace("budget = { passes = 64 }", ""),
+            "[reference]",
+        ),
+        (
+            "zero runs",
+            good.replace("runs = 2", "runs = 0"),
+            "runs = 0",
+        ),
         (
             "malformed",
             good.replace("checkpoints = 6", "checkpoints = = 6"),
+            "checkpoints = = 6",
         ),
     ];
-    for (what, text) in cases {
+    for (what, text, on_line) in cases {
         let path = dir.join(format!("{}.toml", what.replace(' ', "_")));
-        std::fs::write(&path, text).unwrap();
+        std::fs::write(&path, &text).unwrap();
         let err = Experiment::load(&path, false).unwrap_err().to_string();
+        let line = 1 + text[..text.find(on_line).expect(what)]
+            .matches('\n')
+            .count();
+        let named = path.display().to_string();
+        // Checks by the loader name `file:line`; the TOML parser says "at line N".
         assert!(
-            err.contains(path.file_name().unwrap().to_str().unwrap()),
-            "{what}: {err}"
+            err.contains(&format!("{named}:{line}:"))
+                || (err.contains(&named) && err.contains(&format!("at line {line},"))),
+            "{what}: expected line {line}: {err}"
         );
     }
 

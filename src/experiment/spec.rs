@@ -34,6 +34,7 @@ use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
 use serde::Deserialize;
+use toml::Spanned;
 
 use crate::error::{Error, Location, Result};
 use crate::estimator::ESTIMATOR_NAMES;
@@ -47,18 +48,17 @@ struct SpecFile {
     scene: PathBuf,
     #[serde(default)]
     scene_params: BTreeMap<String, toml::Value>,
-    budget: BudgetFile,
-    checkpoints: u32,
-    runs: u32,
+    budget: Spanned<BudgetFile>,
+    checkpoints: Spanned<u32>,
+    runs: Spanned<u32>,
     #[serde(default)]
     seed: u64,
-    reference: ReferenceFile,
+    reference: Spanned<ReferenceFile>,
     #[serde(rename = "estimator")]
-    estimators: Vec<EstimatorFile>,
+    estimators: Vec<Spanned<EstimatorFile>>,
     #[serde(default, rename = "region")]
-    regions: Vec<Region>,
-    #[serde(default)]
-    quick: QuickFile,
+    regions: Vec<Spanned<Region>>,
+    quick: Option<Spanned<QuickFile>>,
 }
 
 #[derive(Clone, Copy, Debug, Deserialize)]
@@ -163,6 +163,10 @@ pub struct Experiment {
     pub regions: Vec<Region>,
 }
 
+/// The most independent runs per estimator (every run is a cell that writes its own
+/// checkpoints; more belong in several experiments).
+pub const MAX_RUNS: u32 = 10_000;
+
 /// The largest number of checkpoints (each doubles the previous budget).
 pub const MAX_CHECKPOINTS: u32 = 24;
 
@@ -176,6 +180,14 @@ impl Experiment {
 
     pub fn parse(text: &str, path: &Path, quick: bool) -> Result<Experiment> {
         let fail = |message: String| Error::input(Location::file(path), message);
+        // An error at the value `span` covers: the file, its line and the key.
+        let fail_at = |span: std::ops::Range<usize>, key: &str, message: String| {
+            let line = 1 + text.as_bytes()[..span.start.min(text.len())]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count();
+            Error::input(Location::at(path, line as u32, key), message)
+        };
         let file: SpecFile = toml::from_str(text).map_err(|e| fail(e.to_string()))?;
         let dir = path.parent().unwrap_or(Path::new("."));
         let stem = path
@@ -183,33 +195,50 @@ impl Experiment {
             .and_then(|s| s.to_str())
             .ok_or_else(|| fail("the experiment file needs a UTF-8 name".into()))?;
 
-        if file.runs == 0 {
-            return Err(fail("runs must be at least 1".into()));
+        let runs_written = *file.runs.get_ref();
+        if runs_written == 0 || runs_written > MAX_RUNS {
+            return Err(fail_at(
+                file.runs.span(),
+                "runs",
+                format!("runs must be between 1 and {MAX_RUNS}, got {runs_written}"),
+            ));
         }
-        if file.checkpoints == 0 || file.checkpoints > MAX_CHECKPOINTS {
-            return Err(fail(format!(
-                "checkpoints must be between 1 and {MAX_CHECKPOINTS}, got {}",
-                file.checkpoints
-            )));
+        let checkpoints = *file.checkpoints.get_ref();
+        if checkpoints == 0 || checkpoints > MAX_CHECKPOINTS {
+            return Err(fail_at(
+                file.checkpoints.span(),
+                "checkpoints",
+                format!("checkpoints must be between 1 and {MAX_CHECKPOINTS}, got {checkpoints}"),
+            ));
         }
-        if !(file.quick.scale > 0.0 && file.quick.scale <= 1.0) || file.quick.runs == 0 {
-            return Err(fail(
+        let quick_file = file
+            .quick
+            .as_ref()
+            .map_or_else(QuickFile::default, |q| *q.get_ref());
+        if !(quick_file.scale > 0.0 && quick_file.scale <= 1.0) || quick_file.runs == 0 {
+            let span = file.quick.as_ref().map_or(0..0, |q| q.span());
+            return Err(fail_at(
+                span,
+                "[quick]",
                 "[quick] needs 0 < scale <= 1 and runs >= 1".to_string(),
             ));
         }
-        let scale = if quick { file.quick.scale } else { 1.0 };
-        let budget = parse_budget(&file.budget, "budget", scale).map_err(fail)?;
+        let scale = if quick { quick_file.scale } else { 1.0 };
+        let budget = parse_budget(file.budget.get_ref(), "budget", scale)
+            .map_err(|m| fail_at(file.budget.span(), "budget", m))?;
         let runs = if quick {
-            file.runs.min(file.quick.runs)
+            runs_written.min(quick_file.runs)
         } else {
-            file.runs
+            runs_written
         };
 
         if file.estimators.is_empty() {
             return Err(fail("no [[estimator]]: nothing to compare".into()));
         }
         let mut estimators: Vec<EstimatorEntry> = Vec::new();
-        for e in &file.estimators {
+        for spanned in &file.estimators {
+            let e = spanned.get_ref();
+            let fail = |m: String| fail_at(spanned.span(), "[[estimator]]", m);
             check_estimator_name(&e.name).map_err(fail)?;
             let label = e.label.clone().unwrap_or_else(|| e.name.clone());
             if !is_safe_label(&label) {
@@ -233,29 +262,30 @@ impl Experiment {
             });
         }
 
-        let reference = match (&file.reference.file, &file.reference.estimator) {
+        let fail_reference = |m: String| fail_at(file.reference.span(), "[reference]", m);
+        let reference_file = file.reference.get_ref();
+        let reference = match (&reference_file.file, &reference_file.estimator) {
             (Some(f), None) => {
-                if file.reference.budget.is_some() || !file.reference.params.is_empty() {
-                    return Err(fail(
+                if reference_file.budget.is_some() || !reference_file.params.is_empty() {
+                    return Err(fail_reference(
                         "[reference] with a file takes no budget or params".into(),
                     ));
                 }
                 ReferenceSource::File(dir.join(f))
             }
             (None, Some(estimator)) => {
-                check_estimator_name(estimator).map_err(fail)?;
-                let b = file
-                    .reference
-                    .budget
-                    .ok_or_else(|| fail("[reference] with an estimator needs a budget".into()))?;
+                check_estimator_name(estimator).map_err(fail_reference)?;
+                let b = reference_file.budget.ok_or_else(|| {
+                    fail_reference("[reference] with an estimator needs a budget".into())
+                })?;
                 ReferenceSource::Render {
                     estimator: estimator.clone(),
-                    params: params_to_strings(&file.reference.params).map_err(fail)?,
-                    budget: parse_budget(&b, "reference.budget", scale).map_err(fail)?,
+                    params: params_to_strings(&reference_file.params).map_err(fail_reference)?,
+                    budget: parse_budget(&b, "reference.budget", scale).map_err(fail_reference)?,
                 }
             }
             _ => {
-                return Err(fail(
+                return Err(fail_reference(
                     "[reference] needs either file = \"...\" or estimator = \"...\" with a budget"
                         .into(),
                 ));
@@ -263,7 +293,9 @@ impl Experiment {
         };
 
         let mut regions: Vec<Region> = Vec::new();
-        for r in &file.regions {
+        for spanned in &file.regions {
+            let r = spanned.get_ref();
+            let fail = |m: String| fail_at(spanned.span(), "[[region]]", m);
             if r.width == 0 || r.height == 0 {
                 return Err(fail(format!("region \"{}\" is empty", r.label)));
             }
@@ -294,7 +326,7 @@ impl Experiment {
             scene: dir.join(&file.scene),
             scene_params,
             budget,
-            checkpoints: file.checkpoints,
+            checkpoints,
             runs,
             seed: file.seed,
             reference,
