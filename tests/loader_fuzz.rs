@@ -9,10 +9,10 @@ mod fuzz_support;
 mod loader_support;
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use fuzz_support::{Rng, mutate};
-use loader_support::{scratch, write};
+use fuzz_support::{check_mutants, shipped_files};
+use loader_support::scratch;
 use mltbench::estimator::{self, Params};
 use mltbench::render::{Budget, render};
 use mltbench::scene::{Scene, mitsuba};
@@ -22,16 +22,16 @@ const MUTANTS: usize = 1000;
 /// Largest film side rendered for a mutant that loads (the loader caps sides far higher).
 const RENDER_SIDE: u32 = 12;
 
-/// Loads, builds and renders one mutant; Err(what went wrong) if it panicked, failed without
-/// naming the file, or rendered a non-finite pixel.
-fn check_mutant(path: &Path) -> Result<(), String> {
+/// Loads, builds and renders one mutant: Ok(whether it loaded), or Err(what went wrong) if
+/// something panicked, an error did not name the file, or a pixel came out non-finite.
+fn check_mutant(path: &Path) -> Result<bool, String> {
     let loaded = catch_unwind(|| mitsuba::load_file(path)).map_err(|_| "the loader panicked")?;
     let mut desc = match loaded {
         Ok(desc) => desc,
         Err(e) => {
             let message = e.to_string();
             return if message.contains(&path.display().to_string()) {
-                Ok(())
+                Ok(false)
             } else {
                 Err(format!("the error does not name the file: {message}"))
             };
@@ -44,7 +44,7 @@ fn check_mutant(path: &Path) -> Result<(), String> {
         .map_err(|_| "building the scene panicked")?;
     let scene = match built {
         Ok(scene) => scene,
-        Err(e) if e.to_string().contains(&path.display().to_string()) => return Ok(()),
+        Err(e) if e.to_string().contains(&path.display().to_string()) => return Ok(false),
         Err(e) => return Err(format!("the build error does not name the file: {e}")),
     };
     for name in ["pt", "eyelight"] {
@@ -63,43 +63,15 @@ fn check_mutant(path: &Path) -> Result<(), String> {
             return Err(format!("{name} wrote a non-finite pixel"));
         }
     }
-    Ok(())
-}
-
-fn shipped_scenes() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/scenes");
-    let mut scenes: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("experiments/scenes")
-        .map(|e| e.expect("folder entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "xml"))
-        .collect();
-    scenes.sort();
-    scenes
+    Ok(true)
 }
 
 #[test]
 fn damaged_scenes_load_or_fail_cleanly() {
-    let dir = scratch("fuzz");
-    let mut rng = Rng(0xf022_5eed);
-    let mut failures = Vec::new();
-    let (mut loaded, mut total) = (0, 0);
-    for scene in shipped_scenes() {
-        let text = std::fs::read(&scene).expect("shipped scene");
-        for k in 0..MUTANTS {
-            let (mutant, what) = mutate(&text, &mut rng);
-            let path = write(&dir, "mutant.xml", &mutant);
-            total += 1;
-            match check_mutant(&path) {
-                Ok(()) => loaded += mitsuba::load_file(&path).is_ok() as usize,
-                Err(e) => failures.push(format!(
-                    "{} mutant {k} ({what}): {e}",
-                    scene.file_name().unwrap().to_string_lossy()
-                )),
-            }
-        }
-    }
+    let scratch = scratch("fuzz").join("mutant.xml");
+    let scenes = shipped_files("experiments/scenes", "xml");
+    let (loaded, total) = check_mutants(&scenes, MUTANTS, 0xf022_5eed, &scratch, check_mutant);
     println!("{loaded} of {total} mutants loaded and rendered; the others were refused");
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
     // The mutations must leave some scenes loadable, or the render half would test nothing.
     assert!(
         loaded > total / 10,

@@ -7,10 +7,10 @@ mod fuzz_support;
 mod loader_support;
 
 use std::panic::catch_unwind;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use fuzz_support::{Rng, mutate};
-use loader_support::{scratch, write};
+use fuzz_support::{check_mutants, shipped_files};
+use loader_support::scratch;
 use mltbench::experiment::spec::Experiment;
 use mltbench::render::Budget;
 
@@ -50,40 +50,12 @@ fn check_mutant(path: &Path) -> Result<bool, String> {
     Ok(parsed)
 }
 
-fn shipped_specs() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments");
-    let mut specs: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("experiments")
-        .map(|e| e.expect("folder entry").path())
-        .filter(|p| p.extension().is_some_and(|e| e == "toml"))
-        .collect();
-    specs.sort();
-    specs
-}
-
 #[test]
 fn damaged_specs_parse_or_fail_cleanly() {
-    let dir = scratch("spec-fuzz");
-    let mut rng = Rng(0x5bec_f022);
-    let mut failures = Vec::new();
-    let (mut parsed, mut total) = (0, 0);
-    for spec in shipped_specs() {
-        let text = std::fs::read(&spec).expect("shipped spec");
-        for k in 0..MUTANTS {
-            let (mutant, what) = mutate(&text, &mut rng);
-            let path = write(&dir, "mutant.toml", &mutant);
-            total += 1;
-            match check_mutant(&path) {
-                Ok(ok) => parsed += ok as usize,
-                Err(e) => failures.push(format!(
-                    "{} mutant {k} ({what}): {e}",
-                    spec.file_name().unwrap().to_string_lossy()
-                )),
-            }
-        }
-    }
+    let scratch = scratch("spec-fuzz").join("mutant.toml");
+    let specs = shipped_files("experiments", "toml");
+    let (parsed, total) = check_mutants(&specs, MUTANTS, 0x5bec_f022, &scratch, check_mutant);
     println!("{parsed} of {total} mutants parsed; the others were refused");
-    assert!(failures.is_empty(), "{}", failures.join("\n"));
     assert!(
         parsed > total / 10,
         "only {parsed} of {total} mutants parsed"

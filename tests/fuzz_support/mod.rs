@@ -3,6 +3,8 @@
 //! lines deleted or doubled; bytes deleted; garbage (non-UTF-8 too) inserted; truncation.
 #![allow(dead_code)]
 
+use std::path::{Path, PathBuf};
+
 /// SplitMix64 (Steele et al. 2014): a small, seedable generator.
 pub struct Rng(pub u64);
 
@@ -232,4 +234,48 @@ pub fn mutate(text: &[u8], rng: &mut Rng) -> (Vec<u8>, String) {
             (text[..end].to_vec(), format!("truncated at byte {end}"))
         }
     }
+}
+
+/// The files `*.EXT` in the crate's folder `dir` (e.g. `experiments/scenes`), sorted.
+pub fn shipped_files(dir: &str, ext: &str) -> Vec<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(dir);
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
+        .map(|e| e.expect("folder entry").path())
+        .filter(|p| p.extension().is_some_and(|e| e == ext))
+        .collect();
+    files.sort();
+    files
+}
+
+/// Writes `mutants` mutations of each of `files` (seeded with `seed`) to `scratch`, one at a
+/// time, and runs `check` on each: Ok(whether it was accepted) or Err(what went wrong).
+/// Returns (accepted, total), and panics listing every mutant that went wrong.
+pub fn check_mutants(
+    files: &[PathBuf],
+    mutants: usize,
+    seed: u64,
+    scratch: &Path,
+    check: impl Fn(&Path) -> Result<bool, String>,
+) -> (usize, usize) {
+    let mut rng = Rng(seed);
+    let mut failures = Vec::new();
+    let (mut accepted, mut total) = (0, 0);
+    for file in files {
+        let text = std::fs::read(file).expect("shipped file");
+        for k in 0..mutants {
+            let (mutant, what) = mutate(&text, &mut rng);
+            std::fs::write(scratch, &mutant).expect("write mutant");
+            total += 1;
+            match check(scratch) {
+                Ok(ok) => accepted += ok as usize,
+                Err(e) => failures.push(format!(
+                    "{} mutant {k} ({what}): {e}",
+                    file.file_name().unwrap().to_string_lossy()
+                )),
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+    (accepted, total)
 }
