@@ -196,6 +196,8 @@ fn run_render(args: RenderArgs) -> Result<()> {
         )));
     }
 
+    // Refused now rather than after the render: its result would be lost.
+    io::atomic::check_writable(&output)?;
     let scene_params = parse_defines(&args.common.define)?;
     let description = mitsuba::load_file_with(&args.common.scene, &scene_params)?;
     for warning in &description.warnings {
@@ -215,15 +217,7 @@ fn run_render(args: RenderArgs) -> Result<()> {
         (None, None) => Budget::Passes(scene.description.sensor.sample_count.max(1)),
     };
 
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(args.common.threads.unwrap_or(0))
-        .build()
-        .map_err(|e| {
-            Error::usage(format!(
-                "cannot start {:?} threads: {e}",
-                args.common.threads
-            ))
-        })?;
+    let pool = thread_pool(args.common.threads)?;
     let mut estimator =
         estimator::create(&args.common.estimator, &params, &scene, args.common.seed)?;
 
@@ -265,7 +259,16 @@ fn run_render(args: RenderArgs) -> Result<()> {
     Ok(())
 }
 
+/// The most worker threads `--threads` may ask for.
+const MAX_THREADS: usize = 4096;
+
+/// A pool of `threads` workers (all cores for None or 0).
 fn thread_pool(threads: Option<usize>) -> Result<rayon::ThreadPool> {
+    if let Some(n) = threads.filter(|&n| n > MAX_THREADS) {
+        return Err(Error::usage(format!(
+            "--threads {n}: at most {MAX_THREADS} (0 or none: all cores)"
+        )));
+    }
     rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()
@@ -395,6 +398,7 @@ fn render_reference(args: ReferenceArgs) -> Result<()> {
             .unwrap_or("scene");
         PathBuf::from(format!("{stem}-reference.exr"))
     });
+    io::atomic::check_writable(&output)?;
     let scene = Scene::build(mitsuba::load_file_with(
         &args.common.scene,
         &parse_defines(&args.common.define)?,

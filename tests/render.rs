@@ -201,6 +201,43 @@ fn cli_renders_exr_and_png_and_fails_cleanly_on_bad_input() {
             ],
             "foo",
         ),
+        (
+            vec![
+                "render",
+                scene.to_str().unwrap(),
+                "--estimator",
+                "eyelight",
+                "--threads",
+                "1000000",
+            ],
+            "--threads",
+        ),
+        // An output that cannot be written is refused before the scene is even read (the
+        // scene here is broken too), so no render's result is lost at the end.
+        (
+            vec![
+                "render",
+                broken.to_str().unwrap(),
+                "--estimator",
+                "eyelight",
+                "-o",
+                "no/such/folder/out.exr",
+            ],
+            "no/such/folder/out.exr",
+        ),
+        (
+            vec![
+                "reference",
+                broken.to_str().unwrap(),
+                "--estimator",
+                "pt",
+                "--spp",
+                "4",
+                "-o",
+                "no/such/folder/ref.exr",
+            ],
+            "no/such/folder/ref.exr",
+        ),
     ];
     for (args, needle) in cases {
         let _ = std::fs::remove_file(dir.join("broken.exr"));

@@ -34,6 +34,21 @@ where
     Ok(())
 }
 
+/// Fails, naming `path`, when `path` could not be written: its folder is missing or not
+/// writable, or it names a folder. Checked before a long render, so that its result is not
+/// lost at the end. Creates and removes a temporary file beside `path`.
+pub fn check_writable(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        return Err(Error::io(
+            path,
+            std::io::Error::new(std::io::ErrorKind::IsADirectory, "is a folder"),
+        ));
+    }
+    let (temp_path, file) = create_temp(path)?;
+    drop(file);
+    fs::remove_file(&temp_path).map_err(|e| Error::io(&temp_path, e))
+}
+
 /// Writes `bytes` to `path` atomically.
 pub fn write_file_atomically(path: &Path, bytes: &[u8]) -> Result<()> {
     write_atomically(path, |w| w.write_all(bytes).map_err(|e| Error::io(path, e)))
