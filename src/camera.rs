@@ -25,12 +25,14 @@
 //! depend on it. `generate_ray` and `project` are the chief ray (through the lens centre):
 //! exact for a pinhole, and for a thin lens where points on the focus plane land.
 //!
-//! Light tracing: `importance` (We) and `pdf_direction` are the pinhole's sensor response and
-//! the solid-angle density of `generate_ray` at uniformly sampled raster positions (for a
-//! thin lens, of its chief rays only). `connect` (pinhole only) and `connect_lens` (any
-//! camera, given a lens sample) are the camera end of a light-tracing connection. A light path's contribution splatted with `Film::splat` needs
-//! the splat scale width · height / (number of light paths) to give per-pixel values in the
-//! same units as the camera-side estimates.
+//! Light tracing: `importance_from` (We), `pdf_direction_from` and `pdf_lens_position` are
+//! the sensor response of a ray leaving a camera point (the pinhole or a lens point) and the
+//! densities with which `sample_ray` produces its direction and origin; `importance` and
+//! `pdf_direction` take the pinhole (or the lens centre). `connect` (pinhole only) and
+//! `connect_lens` (any camera, given a lens sample) are the camera end of a light-tracing
+//! connection. A light path's contribution splatted with `Film::splat` needs the splat scale
+//! width · height / (number of light paths) to give per-pixel values in the same units as the
+//! camera-side estimates.
 
 mod thin_lens;
 
@@ -261,36 +263,94 @@ impl Camera {
         Some(Vec2::new(u * self.width as f32, v * self.height as f32))
     }
 
-    /// The pinhole's importance We(ω) for a unit world-space direction ω leaving the camera:
-    /// 1 / (A cos⁴θ) inside the image, 0 outside (pbrt-v3 §16.1.1 with lens area 1;
-    /// Mitsuba 3's `importance` returns this times cos θ).
+    /// The importance We(ω) of a ray leaving the pinhole (or the lens centre) in unit
+    /// world-space direction ω: `importance_from(position(), ω)`.
     pub fn importance(&self, direction: Vec3) -> f32 {
-        match self.plane_cos_theta(direction) {
-            Some(cos) => 1.0 / (self.plane_area * cos * cos * cos * cos),
+        self.importance_from(self.position, direction)
+    }
+
+    /// The solid-angle density of the chief ray's direction when the raster position is
+    /// uniform over the image: `pdf_direction_from(position(), ω)`.
+    pub fn pdf_direction(&self, direction: Vec3) -> f32 {
+        self.pdf_direction_from(self.position, direction)
+    }
+
+    /// The importance We(x, ω) of a ray leaving camera point x (world space: the pinhole, or
+    /// a point of a thin lens's aperture) in unit direction ω, where it lands inside the
+    /// image: 1 / (A cos⁴θ) for a pinhole and 1 / (A π r² cos⁴θ) for a thin lens of radius r,
+    /// with A the image area on the plane z = 1 (pbrt-v3 §16.1.1). 0 outside the image,
+    /// behind the camera and, for a lens, for x off the aperture. With these, a ray of
+    /// `sample_ray` has weight We·cos θ / (`pdf_lens_position` · `pdf_direction_from`) = 1,
+    /// as in Mitsuba 3 (whose `importance` is this times cos θ).
+    pub fn importance_from(&self, origin: Vec3, direction: Vec3) -> f32 {
+        match self.image_cos_theta(origin, direction) {
+            Some(cos) => {
+                1.0 / (self.plane_area * self.lens_area().unwrap_or(1.0) * cos * cos * cos * cos)
+            }
             None => 0.0,
         }
     }
 
-    /// The solid-angle density of the direction of `generate_ray` when the raster position
-    /// is uniform over the whole image: 1 / (A cos³θ) inside the image, 0 outside.
-    pub fn pdf_direction(&self, direction: Vec3) -> f32 {
-        match self.plane_cos_theta(direction) {
+    /// The solid-angle density of the direction of `sample_ray` from camera point x when the
+    /// raster position is uniform over the image: 1 / (A cos³θ) where the ray lands inside
+    /// the image, 0 elsewhere. The same for a lens point as for the pinhole: the rays from
+    /// one lens point through the focus plane spread like the pinhole's through z = 1.
+    pub fn pdf_direction_from(&self, origin: Vec3, direction: Vec3) -> f32 {
+        match self.image_cos_theta(origin, direction) {
             Some(cos) => 1.0 / (self.plane_area * cos * cos * cos),
             None => 0.0,
         }
     }
 
-    /// cos θ between `direction` and the viewing axis, when the direction passes through
-    /// the image (bounds inclusive, as in Mitsuba 3).
-    fn plane_cos_theta(&self, direction: Vec3) -> Option<f32> {
+    /// The density of a camera ray's origin per unit area of the aperture, 1 / (π r²), for
+    /// a thin lens with uniform lens samples; None for a pinhole (or a lens of radius 0),
+    /// whose rays all start at one point.
+    pub fn pdf_lens_position(&self) -> Option<f32> {
+        self.lens_area().map(|a| 1.0 / a)
+    }
+
+    /// π r² for a thin lens of radius r > 0.
+    fn lens_area(&self) -> Option<f32> {
+        let r = self.lens.as_ref()?.radius();
+        (r > 0.0).then_some(std::f32::consts::PI * r * r)
+    }
+
+    /// cos θ between `direction` and the viewing axis, when the ray from camera point
+    /// `origin` in that direction lands inside the image: for a pinhole where it crosses the
+    /// plane z = 1 (`origin` is the pinhole), for a thin lens where it crosses the focus
+    /// plane, seen through the lens centre (`ThinLens::on_plane`); None for an origin off
+    /// the aperture.
+    fn image_cos_theta(&self, origin: Vec3, direction: Vec3) -> Option<f32> {
+        let Some(thin) = &self.lens else {
+            return self.plane_cos_theta(direction);
+        };
+        let a = self.to_world.inverse.transform_point3(origin);
+        // A point of the aperture, up to the rounding of the transforms.
+        let slack = 1e-4 * (1.0 + thin.radius());
+        if !(a.truncate().length() <= thin.radius() + slack && a.z.abs() <= slack) {
+            return None;
+        }
+        let d = self.forward_camera_direction(direction)?;
+        let a = a.truncate().extend(0.0);
+        self.raster_of(thin.on_plane(a, a + d))?;
+        Some(d.z)
+    }
+
+    /// World direction `direction` in camera space, unit length, when it points forward
+    /// (z > 0).
+    fn forward_camera_direction(&self, direction: Vec3) -> Option<Vec3> {
         let d = self
             .to_world
             .inverse
             .transform_vector3(direction)
             .normalize();
-        if d.z.is_nan() || d.z <= 0.0 {
-            return None;
-        }
+        (d.z > 0.0).then_some(d)
+    }
+
+    /// cos θ between `direction` and the viewing axis, when the direction passes through
+    /// the image (bounds inclusive, as in Mitsuba 3).
+    fn plane_cos_theta(&self, direction: Vec3) -> Option<f32> {
+        let d = self.forward_camera_direction(direction)?;
         let x = d.x / d.z;
         let y = d.y / d.z;
         let half_h = self.tan_half_x / self.aspect;

@@ -4,7 +4,7 @@
 
 mod camera_support;
 
-use camera_support::{RECORDED_SENSORS, assert_matches_recorded_ray, lookat};
+use camera_support::{RECORDED_SENSORS, assert_matches_recorded_ray, lookat, triangle_solid_angle};
 
 use glam::{Mat4, Vec2, Vec3};
 use mltbench::camera::{Camera, horizontal_fov_degrees, raster_in_pixel};
@@ -242,18 +242,6 @@ fn project_rejects_points_outside_the_view() {
     );
     assert!(cam.project(Vec3::new(0.0, 0.0, f32::NAN)).is_none(), "NaN");
     assert!(cam.project(Vec3::new(0.0, 0.0, 0.02)).is_some());
-}
-
-/// Solid angle of the spherical triangle (a, b, c) (Van Oosterom & Strackee 1983).
-fn triangle_solid_angle(a: Vec3, b: Vec3, c: Vec3) -> f64 {
-    let (a, b, c) = (
-        a.normalize().as_dvec3(),
-        b.normalize().as_dvec3(),
-        c.normalize().as_dvec3(),
-    );
-    let num = a.dot(b.cross(c)).abs();
-    let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
-    2.0 * num.atan2(den)
 }
 
 #[test]

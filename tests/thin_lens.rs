@@ -5,7 +5,7 @@
 mod camera_support;
 mod chi2_support;
 
-use camera_support::{RECORDED_SENSORS, assert_matches_recorded_ray, lookat};
+use camera_support::{RECORDED_SENSORS, assert_matches_recorded_ray, lookat, triangle_solid_angle};
 use chi2_support::pearson_uniform;
 
 use glam::{Vec2, Vec3};
@@ -365,5 +365,101 @@ fn matches_rays_recorded_from_mitsuba_3() {
         let ray = Camera::new(&s).sample_ray(Vec2::new(x, y), Vec2::from(u));
         let what = format!("case {case} raster ({x}, {y}) lens {u:?}");
         assert_matches_recorded_ray(&ray, o, d, maxt, &what);
+    }
+}
+
+#[test]
+fn importance_and_densities_follow_sample_ray() {
+    let camera = tilted(Some((0.3, 2.0)));
+    let pdf_position = camera
+        .pdf_lens_position()
+        .expect("a lens has an area density");
+    assert!((pdf_position * std::f32::consts::PI * 0.09 - 1.0).abs() < 1e-6);
+    let cell = 1.0f32;
+    let (w, h) = (camera.width() as f32, camera.height() as f32);
+    // From an off-centre lens point, raster cells of uniform probability cell²/(W·H): the
+    // density at the cell's centre times the cell's solid angle (from its corner rays alone,
+    // independently of the cos³ formula) must give that probability.
+    for u in [
+        Vec2::new(0.9, 0.2),
+        Vec2::new(0.5, 0.5),
+        Vec2::new(0.05, 0.7),
+    ] {
+        let origin = lens_point(&camera, &camera.sample_ray(Vec2::new(w, h) * 0.5, u));
+        let (mut total, mut worst) = (0.0f64, 0.0f64);
+        let mut y = 0.0;
+        while y < h {
+            let mut x = 0.0;
+            while x < w {
+                let d = |dx: f32, dy: f32| camera.sample_ray(Vec2::new(x + dx, y + dy), u).d;
+                let omega = triangle_solid_angle(d(0.0, 0.0), d(cell, 0.0), d(cell, cell))
+                    + triangle_solid_angle(d(0.0, 0.0), d(cell, cell), d(0.0, cell));
+                let centre = d(0.5 * cell, 0.5 * cell);
+                let p = camera.pdf_direction_from(origin, centre) as f64;
+                worst = worst.max((p * omega / (cell * cell / (w * h)) as f64 - 1.0).abs());
+                total += p * omega;
+                // Mitsuba's weight of a sampled ray: We cos θ / (p_A p_ω) = 1.
+                let cos = centre.dot(camera.forward());
+                let we = camera.importance_from(origin, centre);
+                let weight = we * cos / (pdf_position * p as f32);
+                assert!((weight - 1.0).abs() < 1e-4, "weight {weight}");
+                x += cell;
+            }
+            y += cell;
+        }
+        assert!(
+            worst < 2e-3,
+            "lens sample {u}: worst relative error {worst}"
+        );
+        assert!((total - 1.0).abs() < 1e-4, "lens sample {u}: total {total}");
+    }
+}
+
+#[test]
+fn importance_is_zero_where_no_camera_ray_goes() {
+    let camera = tilted(Some((0.3, 2.0)));
+    let u = Vec2::new(0.8, 0.3);
+    let ray = camera.sample_ray(Vec2::new(2.0, 3.0), u);
+    let origin = lens_point(&camera, &ray);
+    assert!(camera.importance_from(origin, ray.d) > 0.0);
+    // Backwards, or far outside the field of view.
+    assert_eq!(camera.importance_from(origin, -ray.d), 0.0);
+    let right = camera.forward().cross(Vec3::Y).normalize();
+    let wide = (camera.forward() + right * 10.0).normalize();
+    assert_eq!(camera.importance_from(origin, wide), 0.0);
+    assert_eq!(camera.pdf_direction_from(origin, wide), 0.0);
+    // From a point beyond the aperture, nothing.
+    let outside = camera.position() + right * 0.5;
+    assert_eq!(camera.importance_from(outside, camera.forward()), 0.0);
+    // The lens centre: `importance` is the chief ray's.
+    let d = camera.generate_ray(Vec2::new(10.0, 40.0)).d;
+    assert_eq!(
+        camera.importance(d),
+        camera.importance_from(camera.position(), d)
+    );
+    // A pinhole's rays all start at the pinhole: no area density.
+    assert_eq!(tilted(None).pdf_lens_position(), None);
+}
+
+#[test]
+fn connections_are_importance_over_the_lens_density() {
+    // A light-tracing connection from p to lens point a carries We(a, a → p) cos θ / d²,
+    // divided by the density of the lens point: the two camera interfaces agree.
+    let camera = tilted(Some((0.3, 2.0)));
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(15);
+    for _ in 0..200 {
+        let u = random_unit(&mut rng);
+        let ray = camera.sample_ray(random_raster(&mut rng, &camera), u);
+        let p = ray.at(0.5 + rng.random::<f32>() * 10.0);
+        let c = camera.connect_lens(p, u).expect("visible");
+        let towards_p = -c.direction_to_camera;
+        let cos = towards_p.dot(camera.forward());
+        let we = camera.importance_from(c.camera_position, towards_p);
+        let expected = we * cos / (c.distance * c.distance) / camera.pdf_lens_position().unwrap();
+        assert!(
+            (c.importance / expected - 1.0).abs() < 1e-4,
+            "{} vs {expected}",
+            c.importance
+        );
     }
 }

@@ -54,3 +54,15 @@ pub const RECORDED_SENSORS: [RecordedSensor; 5] = [
     (30.0, FovAxis::Smaller, 200, 100, [1.0, 2.0, 3.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]),
     (70.0, FovAxis::Larger, 100, 200, [1.0, 2.0, 3.0], [-1.0, 0.0, 0.0], [0.3, 1.0, 0.0]),
 ];
+
+/// Solid angle of the spherical triangle (a, b, c) (Van Oosterom & Strackee 1983).
+pub fn triangle_solid_angle(a: Vec3, b: Vec3, c: Vec3) -> f64 {
+    let (a, b, c) = (
+        a.normalize().as_dvec3(),
+        b.normalize().as_dvec3(),
+        c.normalize().as_dvec3(),
+    );
+    let num = a.dot(b.cross(c)).abs();
+    let den = 1.0 + a.dot(b) + b.dot(c) + c.dot(a);
+    2.0 * num.atan2(den)
+}
