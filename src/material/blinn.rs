@@ -72,9 +72,6 @@ impl BsdfModel for Blinn {
     }
 
     fn flags(&self) -> BsdfFlags {
-        BsdfFlags {
-            non_delta: true,
-            ..Default::default()
-        }
+        BsdfFlags::NON_DELTA_REFLECTION
     }
 }

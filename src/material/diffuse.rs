@@ -44,19 +44,10 @@ impl BsdfModel for Diffuse {
             return None;
         }
         // f cos θ / pdf = (R/π) cos θ / (cos θ/π) = R.
-        Some(BsdfSample {
-            wi,
-            weight: self.reflectance,
-            pdf,
-            delta: false,
-            eta: 1.0,
-        })
+        Some(BsdfSample::non_delta(wi, self.reflectance, pdf))
     }
 
     fn flags(&self) -> BsdfFlags {
-        BsdfFlags {
-            non_delta: true,
-            ..Default::default()
-        }
+        BsdfFlags::NON_DELTA_REFLECTION
     }
 }

@@ -100,6 +100,19 @@ pub struct BsdfSample {
     pub eta: f32,
 }
 
+impl BsdfSample {
+    /// A sample of a component with a density that does not refract (η = 1).
+    pub fn non_delta(wi: Vec3, weight: Rgb, pdf: f32) -> BsdfSample {
+        BsdfSample {
+            wi,
+            weight,
+            pdf,
+            delta: false,
+            eta: 1.0,
+        }
+    }
+}
+
 /// What kinds of components a BSDF has.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct BsdfFlags {
@@ -115,6 +128,14 @@ pub struct BsdfFlags {
 }
 
 impl BsdfFlags {
+    /// A model whose only components have a density and reflect (diffuse, glossy).
+    pub const NON_DELTA_REFLECTION: BsdfFlags = BsdfFlags {
+        delta: false,
+        non_delta: true,
+        transmission: false,
+        null: false,
+    };
+
     pub fn union(self, o: BsdfFlags) -> BsdfFlags {
         BsdfFlags {
             delta: self.delta || o.delta,
@@ -363,13 +384,7 @@ pub(crate) fn reflection_sample(
         return None;
     }
     let weight = model.eval(wo, wi, mode) * (wi.z / pdf);
-    valid_weight(weight).then_some(BsdfSample {
-        wi,
-        weight,
-        pdf,
-        delta: false,
-        eta: 1.0,
-    })
+    valid_weight(weight).then_some(BsdfSample::non_delta(wi, weight, pdf))
 }
 
 /// A weight that must be finite and non-negative, or the sample is dropped.

@@ -134,13 +134,7 @@ impl BsdfModel for Plastic {
         }
         let f_i = fresnel_dielectric(wi.z, self.eta).f;
         let weight = self.diffuse_value(f_o, f_i) * (wi.z / pdf);
-        valid_weight(weight).then_some(BsdfSample {
-            wi,
-            weight,
-            pdf,
-            delta: false,
-            eta: 1.0,
-        })
+        valid_weight(weight).then_some(BsdfSample::non_delta(wi, weight, pdf))
     }
 
     fn flags(&self) -> BsdfFlags {

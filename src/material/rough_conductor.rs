@@ -98,19 +98,10 @@ impl BsdfModel for RoughConductor {
         if !(pdf.is_finite() && pdf > 0.0 && valid_weight(weight)) {
             return None;
         }
-        Some(BsdfSample {
-            wi,
-            weight,
-            pdf,
-            delta: false,
-            eta: 1.0,
-        })
+        Some(BsdfSample::non_delta(wi, weight, pdf))
     }
 
     fn flags(&self) -> BsdfFlags {
-        BsdfFlags {
-            non_delta: true,
-            ..Default::default()
-        }
+        BsdfFlags::NON_DELTA_REFLECTION
     }
 }

@@ -171,10 +171,7 @@ impl BsdfModel for RoughPlastic {
     }
 
     fn flags(&self) -> BsdfFlags {
-        BsdfFlags {
-            non_delta: true,
-            ..Default::default()
-        }
+        BsdfFlags::NON_DELTA_REFLECTION
     }
 }
 

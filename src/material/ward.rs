@@ -98,9 +98,6 @@ impl BsdfModel for Ward {
     }
 
     fn flags(&self) -> BsdfFlags {
-        BsdfFlags {
-            non_delta: true,
-            ..Default::default()
-        }
+        BsdfFlags::NON_DELTA_REFLECTION
     }
 }
