@@ -26,17 +26,7 @@ impl ConstantLight {
     pub fn sample_li(&self, u: Vec2) -> Option<LightSample> {
         let wi = warp::square_to_sphere(u);
         let pdf = warp::sphere_pdf();
-        Some(LightSample {
-            p: wi,
-            n: -wi,
-            primitive: 0,
-            wi,
-            dist: f32::INFINITY,
-            radiance: self.radiance,
-            pdf_solid_angle: pdf,
-            pdf_area: pdf,
-            delta: false,
-        })
+        Some(LightSample::at_infinity(wi, self.radiance, pdf))
     }
 
     pub fn pdf_li(&self) -> f32 {

@@ -229,17 +229,7 @@ impl EnvmapLight {
 
     pub fn sample_li(&self, u: Vec2) -> Option<LightSample> {
         let (wi, pdf) = self.sample_direction(u)?;
-        Some(LightSample {
-            p: wi,
-            n: -wi,
-            primitive: 0,
-            wi,
-            dist: f32::INFINITY,
-            radiance: self.le(wi),
-            pdf_solid_angle: pdf,
-            pdf_area: pdf,
-            delta: false,
-        })
+        Some(LightSample::at_infinity(wi, self.le(wi), pdf))
     }
 
     /// A direction by the map's distribution, a uniform point of the disk of radius R

@@ -91,7 +91,51 @@ pub struct LightSample {
     pub delta: bool,
 }
 
+/// From reference point `r` towards a light at `position`: (unit direction, distance,
+/// squared distance); None when `r` is at the light or infinitely far from it.
+pub(crate) fn towards_point(position: Vec3, r: Vec3) -> Option<(Vec3, f32, f32)> {
+    let d = position - r;
+    let dist2 = d.length_squared();
+    if !(dist2 > 0.0 && dist2.is_finite()) {
+        return None;
+    }
+    let dist = dist2.sqrt();
+    Some((d / dist, dist, dist2))
+}
+
 impl LightSample {
+    /// The sample of a light at infinity arriving from unit direction `wi` with radiance
+    /// `radiance`, drawn with solid-angle density `pdf`.
+    pub fn at_infinity(wi: Vec3, radiance: Rgb, pdf: f32) -> LightSample {
+        LightSample {
+            p: wi,
+            n: -wi,
+            primitive: 0,
+            wi,
+            dist: f32::INFINITY,
+            radiance,
+            pdf_solid_angle: pdf,
+            pdf_area: pdf,
+            delta: false,
+        }
+    }
+
+    /// The sample of a delta light at `position`, reached from the reference point along
+    /// unit direction `wi` at distance `dist`, carrying `radiance` (intensity / d²).
+    pub fn from_point_light(position: Vec3, wi: Vec3, dist: f32, radiance: Rgb) -> LightSample {
+        LightSample {
+            p: position,
+            n: Vec3::ZERO,
+            primitive: 0,
+            wi,
+            dist,
+            radiance,
+            pdf_solid_angle: 1.0,
+            pdf_area: 1.0,
+            delta: true,
+        }
+    }
+
     /// The light point as `pdf_li` and `le` take it.
     pub fn point(&self) -> LightPoint {
         LightPoint {

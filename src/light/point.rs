@@ -2,7 +2,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::light::{EmissionSample, LightSample};
+use crate::light::{EmissionSample, LightSample, towards_point};
 use crate::math::{PI, Rgb, warp};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,24 +27,14 @@ impl PointLight {
 
     /// The only direction: towards the light, carrying I/d² (a delta sample, pdf 1).
     pub fn sample_li(&self, r: Vec3) -> Option<LightSample> {
-        let d = self.position - r;
-        let dist2 = d.length_squared();
-        if !(dist2 > 0.0 && dist2.is_finite()) {
-            return None;
-        }
-        let dist = dist2.sqrt();
-        let wi = d / dist;
-        Some(LightSample {
-            p: self.position,
-            n: Vec3::ZERO,
-            primitive: 0,
+        let (wi, dist, dist2) = towards_point(self.position, r)?;
+        let radiance = self.intensity / dist2;
+        Some(LightSample::from_point_light(
+            self.position,
             wi,
             dist,
-            radiance: self.intensity / dist2,
-            pdf_solid_angle: 1.0,
-            pdf_area: 1.0,
-            delta: true,
-        })
+            radiance,
+        ))
     }
 
     /// A uniform direction on the sphere (pdf 1/4π) from the light's position.

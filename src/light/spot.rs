@@ -8,7 +8,7 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::light::{EmissionSample, LightSample};
+use crate::light::{EmissionSample, LightSample, towards_point};
 use crate::math::{Frame, PI, Rgb, Transform, warp};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,28 +80,18 @@ impl SpotLight {
 
     /// Towards the light, carrying I f(θ)/d² (a delta sample, pdf 1); None outside the cone.
     pub fn sample_li(&self, r: Vec3) -> Option<LightSample> {
-        let d = self.position - r;
-        let dist2 = d.length_squared();
-        if !(dist2 > 0.0 && dist2.is_finite()) {
-            return None;
-        }
-        let dist = dist2.sqrt();
-        let wi = d / dist;
+        let (wi, dist, dist2) = towards_point(self.position, r)?;
         let f = self.falloff(-wi);
         if f.is_nan() || f <= 0.0 {
             return None;
         }
-        Some(LightSample {
-            p: self.position,
-            n: Vec3::ZERO,
-            primitive: 0,
+        let radiance = self.intensity * (f / dist2);
+        Some(LightSample::from_point_light(
+            self.position,
             wi,
             dist,
-            radiance: self.intensity * (f / dist2),
-            pdf_solid_angle: 1.0,
-            pdf_area: 1.0,
-            delta: true,
-        })
+            radiance,
+        ))
     }
 
     /// A direction uniform in the cutoff cone (as Mitsuba), weighted by the falloff.
