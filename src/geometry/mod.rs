@@ -213,12 +213,11 @@ pub struct AnalyticHit {
     pub uv: Vec2,
 }
 
-/// The interaction at analytic hit `h` of shape `shape`, found at t (in the scaled ray's
-/// units) along `r`. Analytic shapes have no separate shading normal.
+/// The interaction at analytic hit `h`, the surface data of `found`. Analytic shapes have
+/// no separate shading normal.
 #[inline(always)]
-fn analytic_interaction(h: AnalyticHit, t: f64, r: &ScaledRay, shape: u32) -> SurfaceInteraction {
-    let t = (t / r.scale as f64) as f32;
-    interaction(h.p, h.p_error, t, h.n, h.n, h.uv, shape, 0)
+fn analytic_interaction(h: AnalyticHit, found: &ClosestHit) -> SurfaceInteraction {
+    interaction(h.p, h.p_error, found.t, h.n, h.n, h.uv, found.shape, 0)
 }
 
 /// The closest hit of a ray as the kernel finds it (`Geometry::closest_hit`): the distance
@@ -381,7 +380,13 @@ impl Geometry {
         if let Some((record, h)) = self.bvh.closest(&TraversalRay::new(r.o, r.d), t_max) {
             hit = Some(Hit::Triangle { record, hit: h });
         }
-        let hit = hit?;
+        Some(self.found(hit?, r))
+    }
+
+    /// The `ClosestHit` of traversal result `hit` along `r`: its distance in the query ray's
+    /// units and its shape and triangle ids, computed once here.
+    #[inline(always)]
+    fn found(&self, hit: Hit, r: ScaledRay) -> ClosestHit {
         let (t, [shape, primitive]) = match hit {
             Hit::Triangle { record, hit } => (hit.t * r.inv_scale, self.bvh.record(record).ids()),
             Hit::Sphere { index, t } => {
@@ -391,19 +396,29 @@ impl Geometry {
                 ((t / r.scale as f64) as f32, [self.disks[index].shape, 0])
             }
         };
-        Some(ClosestHit {
+        ClosestHit {
             t,
             shape,
             primitive,
             hit,
             ray: r,
-        })
+        }
     }
 
     /// The surface data of a hit that `closest_hit` found (the same as `intersect` returns).
     #[inline]
     pub fn interaction(&self, hit: &ClosestHit) -> SurfaceInteraction {
-        self.hit_interaction(hit.hit, &hit.ray)
+        let r = &hit.ray;
+        match hit.hit {
+            Hit::Triangle { record, hit: h } => self.triangle_interaction(record, &h, hit),
+            Hit::Sphere { index, t } => {
+                let h = self.spheres[index].hit(r.o, r.d, t);
+                analytic_interaction(h, hit)
+            }
+            Hit::Disk { index, local, .. } => {
+                analytic_interaction(self.disks[index].hit(local), hit)
+            }
+        }
     }
 
     /// `out[i] = self.intersect(&rays[i])` for every ray, with several BVH traversals in
@@ -431,7 +446,7 @@ impl Geometry {
         });
         for (i, r, hit) in queued {
             if let Some(h) = hit {
-                out[i] = Some(self.hit_interaction(h, &r));
+                out[i] = Some(self.interaction(&self.found(h, r)));
             }
         }
     }
@@ -462,22 +477,6 @@ impl Geometry {
         (hit, t_max)
     }
 
-    /// The surface data of a hit found along the scaled ray `r`.
-    #[inline(always)]
-    fn hit_interaction(&self, hit: Hit, r: &ScaledRay) -> SurfaceInteraction {
-        match hit {
-            Hit::Triangle { record, hit } => self.triangle_interaction(record, &hit, r.inv_scale),
-            Hit::Sphere { index, t } => {
-                let s = &self.spheres[index];
-                analytic_interaction(s.hit(r.o, r.d, t), t, r, s.shape)
-            }
-            Hit::Disk { index, t, local } => {
-                let d = &self.disks[index];
-                analytic_interaction(d.hit(local), t, r, d.shape)
-            }
-        }
-    }
-
     /// True when anything lies on the ray with t < ray.t_max (any-hit shadow query).
     pub fn occluded(&self, ray: &Ray) -> bool {
         let Some(r) = ScaledRay::new(ray) else {
@@ -503,14 +502,13 @@ impl Geometry {
         &self,
         record: u32,
         h: &TriangleHit,
-        inv_scale: f32,
+        found: &ClosestHit,
     ) -> SurfaceInteraction {
         let rec = self.bvh.record(record);
         let v = [rec.vertex(0), rec.vertex(1), rec.vertex(2)];
         let b = h.barycentrics();
         let (p, p_error) = triangle::hit_point(v, b);
         let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
-        let [shape, primitive] = rec.ids();
         let ns = self
             .bvh
             .normals(record)
@@ -522,7 +520,16 @@ impl Geometry {
             .uvs(record)
             .map(|uv| uv[0] * b[0] + uv[1] * b[1] + uv[2] * b[2])
             .unwrap_or(Vec2::new(b[1], b[2]));
-        interaction(p, p_error, h.t * inv_scale, ng, ns, uv, shape, primitive)
+        interaction(
+            p,
+            p_error,
+            found.t,
+            ng,
+            ns,
+            uv,
+            found.shape,
+            found.primitive,
+        )
     }
 }
 
