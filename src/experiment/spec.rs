@@ -195,22 +195,21 @@ impl Experiment {
             .and_then(|s| s.to_str())
             .ok_or_else(|| fail("the experiment file needs a UTF-8 name".into()))?;
 
-        let runs_written = *file.runs.get_ref();
-        if runs_written == 0 || runs_written > MAX_RUNS {
-            return Err(fail_at(
-                file.runs.span(),
-                "runs",
-                format!("runs must be between 1 and {MAX_RUNS}, got {runs_written}"),
-            ));
-        }
-        let checkpoints = *file.checkpoints.get_ref();
-        if checkpoints == 0 || checkpoints > MAX_CHECKPOINTS {
-            return Err(fail_at(
-                file.checkpoints.span(),
-                "checkpoints",
-                format!("checkpoints must be between 1 and {MAX_CHECKPOINTS}, got {checkpoints}"),
-            ));
-        }
+        // A count written in the file, checked to lie in 1..=max.
+        let count_in = |value: &Spanned<u32>, key: &str, max: u32| {
+            let v = *value.get_ref();
+            if (1..=max).contains(&v) {
+                Ok(v)
+            } else {
+                Err(fail_at(
+                    value.span(),
+                    key,
+                    format!("{key} must be between 1 and {max}, got {v}"),
+                ))
+            }
+        };
+        let runs_written = count_in(&file.runs, "runs", MAX_RUNS)?;
+        let checkpoints = count_in(&file.checkpoints, "checkpoints", MAX_CHECKPOINTS)?;
         let quick_file = file
             .quick
             .as_ref()
