@@ -6,6 +6,10 @@
 //! 1. the Cornell box (556 units) with a ~100k-triangle UV sphere,
 //! 2. a smooth displaced sphere of ~1M triangles.
 //!
+//! `flat_crossover/*` times closest and any hits (one thread, incoherent rays) with the
+//! tree and without it (`geometry::flat`) on the Cornell box plus spheres of a few dozen
+//! to a few hundred triangles: where the two cross sets `flat::FLAT_LIMIT`.
+//!
 //! `cargo bench --bench rays` (criterion prints rays/s as "elem/s"). Figures depend on the
 //! CPU features the build targets (`.cargo/config.toml`: target-cpu=native); state them
 //! with every figure (`rustc --print cfg -C target-cpu=native | grep feature`).
@@ -15,7 +19,10 @@ use std::time::Duration;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
-use mltbench::geometry::procedural::{cornell_box_with_sphere, displaced_sphere_1m, mesh_shape};
+use mltbench::geometry::bvh::{TraversalRay, TriangleBvh, TriangleList};
+use mltbench::geometry::procedural::{
+    cornell_box, cornell_box_with_sphere, displaced_sphere_1m, mesh_shape, uv_sphere,
+};
 use mltbench::geometry::{Geometry, Ray};
 use mltbench::scene::ShapeDesc;
 use rayon::prelude::*;
@@ -199,11 +206,75 @@ fn bench_rays(c: &mut Criterion) {
     }
 }
 
+/// The triangles of `shapes` (meshes only) as a plain list.
+fn triangles_of(shapes: &[ShapeDesc]) -> Vec<[Vec3; 3]> {
+    let mut out = Vec::new();
+    for shape in shapes {
+        if let mltbench::scene::ShapeGeometry::Mesh(m) = &shape.geometry {
+            for t in &m.indices {
+                out.push(t.map(|i| m.positions[i as usize]));
+            }
+        }
+    }
+    out
+}
+
+fn bench_flat_crossover(c: &mut Criterion) {
+    let mut group = c.benchmark_group("flat_crossover");
+    group.measurement_time(Duration::from_secs(3));
+    // Sphere rings × segments: 0, 32, 96 and 224 triangles beside the box's 32.
+    for (rings, segments) in [(0u32, 0u32), (3, 8), (5, 12), (8, 16)] {
+        let mut shapes = cornell_box(556.0);
+        if rings > 0 {
+            let sphere = uv_sphere(Vec3::new(278.0, 150.0, 278.0), 120.0, rings, segments);
+            shapes.push(mesh_shape("sphere", sphere));
+        }
+        let vertices = triangles_of(&shapes);
+        let ids: Vec<[u32; 2]> = (0..vertices.len() as u32).map(|i| [0, i]).collect();
+        let list = TriangleList {
+            vertices: &vertices,
+            ids: &ids,
+        };
+        let n = vertices.len();
+        let geometry = Geometry::build(&shapes);
+        let rays: Vec<(TraversalRay, f32)> = incoherent_rays(&geometry, 1 << 16, 7)
+            .iter()
+            .map(|r| (TraversalRay::new(r.o, r.d), r.t_max))
+            .collect();
+        // The shadow-ray case: segments ending halfway to the closest hit.
+        let tree = TriangleBvh::build_with_flat_limit(&list, 0);
+        let flat = TriangleBvh::build_with_flat_limit(&list, usize::MAX);
+        let shadow: Vec<f32> = rays
+            .iter()
+            .map(|(r, t)| tree.closest(r, *t).map_or(*t, |(_, h)| 0.5 * h.t))
+            .collect();
+        group.throughput(Throughput::Elements(rays.len() as u64));
+        for (name, bvh) in [("tree", &tree), ("flat", &flat)] {
+            group.bench_function(format!("{n}/closest_{name}"), |b| {
+                b.iter(|| {
+                    rays.iter()
+                        .filter(|(r, t)| bvh.closest(r, *t).is_some())
+                        .count()
+                })
+            });
+            group.bench_function(format!("{n}/any_{name}"), |b| {
+                b.iter(|| {
+                    rays.iter()
+                        .zip(&shadow)
+                        .filter(|((r, _), t)| bvh.any(r, **t))
+                        .count()
+                })
+            });
+        }
+    }
+    group.finish();
+}
+
 criterion_group! {
     name = benches;
     // No HTML plots: mltbench builds plotters without system-font lookup (its plots embed a
     // font), and criterion's report plots would need one.
     config = Criterion::default().without_plots();
-    targets = bench_rays
+    targets = bench_rays, bench_flat_crossover
 }
 criterion_main!(benches);

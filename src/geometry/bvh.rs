@@ -29,6 +29,7 @@ mod stream;
 pub use stream::IN_FLIGHT;
 
 use super::cwbvh;
+use super::flat::{FLAT_LIMIT, FlatTriangles};
 use super::offset::gamma;
 use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord};
 
@@ -149,6 +150,9 @@ pub struct TriangleBvh {
     uvs: Option<Vec<[Vec2; 3]>>,
     depth: usize,
     bounds: (Vec3, Vec3),
+    /// The records laid out for `flat.rs`, which answers the queries instead of the tree
+    /// when there are at most `FLAT_LIMIT` triangles.
+    flat: Option<FlatTriangles>,
 }
 
 impl TriangleBvh {
@@ -156,6 +160,12 @@ impl TriangleBvh {
     /// collapse (`cwbvh.rs`) and the triangle data in leaf order; the independent steps run
     /// on rayon's threads.
     pub fn build(source: &impl TriangleSource) -> TriangleBvh {
+        Self::build_with_flat_limit(source, FLAT_LIMIT)
+    }
+
+    /// `build`, answering queries without the tree up to `flat_limit` triangles instead of
+    /// `FLAT_LIMIT` (to measure and test both ways on the same triangles).
+    pub fn build_with_flat_limit(source: &impl TriangleSource, flat_limit: usize) -> TriangleBvh {
         let n = source.triangle_count();
         if n == 0 {
             return TriangleBvh::default();
@@ -202,8 +212,10 @@ impl TriangleBvh {
             )
         });
         let nodes = collect_large(wide.nodes.par_iter().copied());
+        let flat = (records.len() <= flat_limit).then(|| FlatTriangles::new(&records));
         TriangleBvh {
             nodes,
+            flat,
             records,
             normals,
             uvs,
@@ -240,6 +252,9 @@ impl TriangleBvh {
     /// Closest triangle with 0 < t < t_max: (record index, its hit data).
     #[inline(always)]
     pub fn closest(&self, ray: &TraversalRay, t_max: f32) -> Option<(u32, TriangleHit)> {
+        if let Some(flat) = &self.flat {
+            return flat.closest(&self.records, &ray.tri, t_max);
+        }
         let mut visitor = Closest {
             bvh: self,
             ray,
@@ -252,6 +267,9 @@ impl TriangleBvh {
     /// True when some triangle lies at 0 < t < t_max.
     #[inline(always)]
     pub fn any(&self, ray: &TraversalRay, t_max: f32) -> bool {
+        if let Some(flat) = &self.flat {
+            return flat.any(&self.records, &ray.tri, t_max);
+        }
         self.traverse_from_root(ray, t_max, &mut Any { bvh: self, ray })
     }
 
@@ -454,6 +472,7 @@ impl Default for TriangleBvh {
             uvs: None,
             depth: 0,
             bounds: (Vec3::INFINITY, Vec3::NEG_INFINITY),
+            flat: None,
         }
     }
 }

@@ -9,6 +9,7 @@
 //! - `bvh/stream.rs`: closest hits for a slice of rays with several traversals in flight
 //!   (`Geometry::intersect_stream`), for scenes too large for the cache.
 //! - `cwbvh.rs`: collapsing obvhs's binary BVH into the 8-wide one.
+//! - `flat.rs`: small scenes answered without the tree, sixteen triangles per test.
 //! - `triangle.rs`: the watertight ray/triangle test and the hit point's error bound.
 //! - `sphere.rs`, `disk.rs`: analytic shapes, tested one by one in f64.
 //! - `offset.rs`: error bounds and robust origins for rays leaving a surface.
@@ -31,6 +32,7 @@
 pub mod bvh;
 pub mod cwbvh;
 pub mod disk;
+pub mod flat;
 pub mod offset;
 pub mod procedural;
 pub mod sphere;

@@ -1,0 +1,384 @@
+//! Small scenes without a tree: every triangle tested against the ray, sixteen at a time.
+//!
+//! On a few dozen triangles (the Cornell box has 36) a BVH query spends most of its time
+//! deciding what not to test: decoding nodes, ordering children, then testing the surviving
+//! leaf triangles one by one. Testing all triangles in lanes costs a few vector operations
+//! per sixteen triangles instead. `TriangleBvh` answers its queries this way up to
+//! `FLAT_LIMIT` triangles (the crossover measured in `benches/rays.rs`, README
+//! "Performance").
+//!
+//! The lanes compute exactly the arithmetic of the watertight test (`triangle.rs`, same
+//! operations in the same order, no fused multiply-adds), and use it only as a filter: a
+//! lane whose edge functions have mixed signs, or whose t lies outside (0, t_max), cannot
+//! pass that test and is dropped. The few that remain (usually one or two per ray) go
+//! through `triangle::intersect` itself, which settles zero edge functions in f64 and the
+//! sign of t near the origin. So this path reports a hit exactly when the per-triangle test
+//! does; only the choice between hits at exactly equal t can differ from the tree's (here
+//! the lowest record index wins).
+
+use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord};
+
+/// Triangles per chunk: one AVX-512 register, or two AVX2 ones.
+const LANES: usize = 16;
+
+/// Scenes with at most this many triangles are answered by `FlatTriangles` (measured
+/// crossover with the tree: README "Performance").
+pub const FLAT_LIMIT: usize = 64;
+
+/// Sixteen triangles, coordinates by axis, then vertex, then lane.
+#[derive(Clone, Copy)]
+#[repr(C, align(64))]
+struct Chunk {
+    v: [[[f32; LANES]; 3]; 3],
+}
+
+/// The triangles of `records`, in the same order, laid out for lane-parallel tests.
+#[derive(Clone, Default)]
+pub struct FlatTriangles {
+    chunks: Vec<Chunk>,
+    count: usize,
+}
+
+impl FlatTriangles {
+    pub fn new(records: &[TriangleRecord]) -> FlatTriangles {
+        let mut chunks = Vec::with_capacity(records.len().div_ceil(LANES));
+        for group in records.chunks(LANES) {
+            // Lanes past the end hold NaN; `lane_mask` keeps them out anyway.
+            let mut c = Chunk {
+                v: [[[f32::NAN; LANES]; 3]; 3],
+            };
+            for (lane, record) in group.iter().enumerate() {
+                for axis in 0..3 {
+                    for vertex in 0..3 {
+                        c.v[axis][vertex][lane] = record.rows[axis][vertex];
+                    }
+                }
+            }
+            chunks.push(c);
+        }
+        FlatTriangles {
+            chunks,
+            count: records.len(),
+        }
+    }
+
+    /// The closest triangle with 0 < t < t_max: (record index, its hit data), as
+    /// `triangle::intersect` finds it.
+    #[inline(always)]
+    pub fn closest(
+        &self,
+        records: &[TriangleRecord],
+        r: &TriangleRay,
+        mut t_max: f32,
+    ) -> Option<(u32, TriangleHit)> {
+        let mut best = None;
+        for (c, chunk) in self.chunks.iter().enumerate() {
+            let mut lanes = candidates(chunk, r, t_max) & self.lane_mask(c);
+            while lanes != 0 {
+                let index = c * LANES + lanes.trailing_zeros() as usize;
+                lanes &= lanes - 1;
+                if let Some(h) = triangle::intersect(&records[index], r, t_max) {
+                    t_max = h.t;
+                    best = Some((index as u32, h));
+                }
+            }
+        }
+        best
+    }
+
+    /// True when some triangle lies at 0 < t < t_max.
+    #[inline(always)]
+    pub fn any(&self, records: &[TriangleRecord], r: &TriangleRay, t_max: f32) -> bool {
+        for (c, chunk) in self.chunks.iter().enumerate() {
+            let mut lanes = candidates(chunk, r, t_max) & self.lane_mask(c);
+            while lanes != 0 {
+                let index = c * LANES + lanes.trailing_zeros() as usize;
+                lanes &= lanes - 1;
+                if triangle::intersect(&records[index], r, t_max).is_some() {
+                    return true;
+                }
+            }
+        }
+        false
+    }
+
+    /// The lanes of chunk `c` that hold triangles.
+    #[inline(always)]
+    fn lane_mask(&self, c: usize) -> u32 {
+        let filled = self.count - c * LANES;
+        if filled >= LANES {
+            (1 << LANES) - 1
+        } else {
+            (1 << filled) - 1
+        }
+    }
+}
+
+/// Bit i set unless lane i certainly fails the watertight test within (0, t_max): its edge
+/// functions have mixed signs, or they are all non-zero and the hit's t lies outside the
+/// range. Lanes with a zero edge function stay set: `triangle::intersect` decides them in
+/// f64.
+#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+#[inline(always)]
+fn candidates(c: &Chunk, r: &TriangleRay, t_max: f32) -> u32 {
+    use std::arch::x86_64::*;
+    // SAFETY: AVX-512F is enabled at compile time (cfg above); `Chunk` is 64-byte aligned
+    // and each row is 16 floats, so the aligned loads stay inside it.
+    unsafe {
+        let load = |row: &[f32; LANES]| _mm512_load_ps(row.as_ptr());
+        let splat = _mm512_set1_ps;
+        let (cx, cy, cz) = (&c.v[r.kx], &c.v[r.ky], &c.v[r.kz]);
+        let (ox, oy, oz) = (splat(r.ox), splat(r.oy), splat(r.oz));
+        let (sx, sy, sz) = (splat(r.sx), splat(r.sy), splat(r.sz));
+        // Sheared vertex coordinates, as `triangle::intersect_scalar`.
+        let vertex = |j: usize| {
+            let z = _mm512_sub_ps(load(&cz[j]), oz);
+            let x = _mm512_sub_ps(_mm512_sub_ps(load(&cx[j]), ox), _mm512_mul_ps(sx, z));
+            let y = _mm512_sub_ps(_mm512_sub_ps(load(&cy[j]), oy), _mm512_mul_ps(sy, z));
+            (x, y, z)
+        };
+        let (x0, y0, z0) = vertex(0);
+        let (x1, y1, z1) = vertex(1);
+        let (x2, y2, z2) = vertex(2);
+        let edge = |xa, yb, ya, xb| _mm512_sub_ps(_mm512_mul_ps(xa, yb), _mm512_mul_ps(ya, xb));
+        let e0 = edge(x2, y1, y2, x1);
+        let e1 = edge(x0, y2, y0, x2);
+        let e2 = edge(x1, y0, y1, x0);
+        let zero = _mm512_setzero_ps();
+        let lt = |e| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(e, zero);
+        let gt = |e| _mm512_cmp_ps_mask::<_CMP_GT_OQ>(e, zero);
+        let ne = |e| _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(e, zero);
+        let any_neg = lt(e0) | lt(e1) | lt(e2);
+        let any_pos = gt(e0) | gt(e1) | gt(e2);
+        let all_nonzero = ne(e0) & ne(e1) & ne(e2);
+        let det = _mm512_add_ps(_mm512_add_ps(e0, e1), e2);
+        let t_num = _mm512_add_ps(
+            _mm512_add_ps(
+                _mm512_mul_ps(e0, _mm512_mul_ps(z0, sz)),
+                _mm512_mul_ps(e1, _mm512_mul_ps(z1, sz)),
+            ),
+            _mm512_mul_ps(e2, _mm512_mul_ps(z2, sz)),
+        );
+        // Both made positive by the determinant's sign. For det = ±0 the flip differs
+        // from the portable code's, but such lanes have a zero edge and are kept anyway.
+        let sign = _mm512_set1_epi32(i32::MIN);
+        let det_bits = _mm512_castps_si512(det);
+        let t_num_p = _mm512_castsi512_ps(_mm512_xor_si512(
+            _mm512_castps_si512(t_num),
+            _mm512_and_si512(det_bits, sign),
+        ));
+        let det_p = _mm512_castsi512_ps(_mm512_andnot_si512(sign, det_bits));
+        let in_range = gt(t_num_p)
+            & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(t_num_p, _mm512_mul_ps(splat(t_max), det_p));
+        (!(any_neg & any_pos) & (!all_nonzero | in_range)) as u32
+    }
+}
+
+/// `candidates` in portable code (autovectorised), for targets without AVX-512.
+#[cfg_attr(
+    all(target_arch = "x86_64", target_feature = "avx512f"),
+    allow(dead_code)
+)]
+#[inline(always)]
+fn candidates_portable(c: &Chunk, r: &TriangleRay, t_max: f32) -> u32 {
+    let (cx, cy, cz) = (&c.v[r.kx], &c.v[r.ky], &c.v[r.kz]);
+    let mut mask = 0u32;
+    for i in 0..LANES {
+        // Sheared vertex coordinates, as `triangle::intersect_scalar`.
+        let vertex = |j: usize| {
+            let z = cz[j][i] - r.oz;
+            let x = (cx[j][i] - r.ox) - r.sx * z;
+            let y = (cy[j][i] - r.oy) - r.sy * z;
+            (x, y, z)
+        };
+        let (x0, y0, z0) = vertex(0);
+        let (x1, y1, z1) = vertex(1);
+        let (x2, y2, z2) = vertex(2);
+        let e0 = x2 * y1 - y2 * x1;
+        let e1 = x0 * y2 - y0 * x2;
+        let e2 = x1 * y0 - y1 * x0;
+        let any_neg = (e0 < 0.0) | (e1 < 0.0) | (e2 < 0.0);
+        let any_pos = (e0 > 0.0) | (e1 > 0.0) | (e2 > 0.0);
+        let all_nonzero = (e0 != 0.0) & (e1 != 0.0) & (e2 != 0.0);
+        let det = (e0 + e1) + e2;
+        let t_num = (e0 * (z0 * r.sz) + e1 * (z1 * r.sz)) + e2 * (z2 * r.sz);
+        // t = T/det with both made positive, as `triangle::hit_from`.
+        let (t_num_p, det_p) = if det < 0.0 {
+            (-t_num, -det)
+        } else {
+            (t_num, det)
+        };
+        // False for NaN edge functions (padding lanes, non-finite vertices), which the
+        // per-triangle test rejects too; they count as non-zero, so they are dropped here.
+        let in_range = (t_num_p > 0.0) & (t_num_p < t_max * det_p);
+        let keep = !(any_neg & any_pos) & (!all_nonzero | in_range);
+        mask |= (keep as u32) << i;
+    }
+    mask
+}
+
+#[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f")))]
+#[inline(always)]
+fn candidates(c: &Chunk, r: &TriangleRay, t_max: f32) -> u32 {
+    candidates_portable(c, r, t_max)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    fn rng(state: &mut u64) -> f32 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        (*state >> 40) as f32 / (1u64 << 24) as f32
+    }
+
+    /// The per-triangle test over all records in order, keeping the first of the closest.
+    fn scan(records: &[TriangleRecord], r: &TriangleRay, mut t_max: f32) -> Option<(u32, f32)> {
+        let mut best = None;
+        for (i, rec) in records.iter().enumerate() {
+            if let Some(h) = triangle::intersect(rec, r, t_max) {
+                t_max = h.t;
+                best = Some((i as u32, h.t));
+            }
+        }
+        best
+    }
+
+    /// A 5×5 grid of unit squares (50 triangles sharing edges and vertices at integer
+    /// coordinates) in the plane z = 0, plus `extra` random triangles around it.
+    fn scene(extra: usize, s: &mut u64) -> Vec<TriangleRecord> {
+        let mut records = Vec::new();
+        for i in 0..5 {
+            for j in 0..5 {
+                let p = |a: i32, b: i32| Vec3::new((i + a) as f32, (j + b) as f32, 0.0);
+                let n = records.len() as u32;
+                records.push(TriangleRecord::new([p(0, 0), p(1, 0), p(1, 1)], 0, n));
+                records.push(TriangleRecord::new([p(0, 0), p(1, 1), p(0, 1)], 0, n + 1));
+            }
+        }
+        for _ in 0..extra {
+            let mut v = || Vec3::new(rng(s) * 6.0 - 0.5, rng(s) * 6.0 - 0.5, rng(s) * 4.0 - 2.0);
+            let n = records.len() as u32;
+            records.push(TriangleRecord::new([v(), v(), v()], 1, n));
+        }
+        records
+    }
+
+    /// Rays at random, and rays through the grid's vertices and edges (zero edge
+    /// functions), from origins on both sides of the plane and on it.
+    fn ray(i: u32, s: &mut u64) -> (TriangleRay, f32) {
+        let grid = |s: &mut u64| (rng(s) * 6.0).floor() - 0.25 + 0.25 * (rng(s) * 3.0).floor();
+        let target = match i % 3 {
+            0 => Vec3::new(grid(s), grid(s), 0.0),
+            1 => Vec3::new(grid(s), rng(s) * 6.0 - 0.5, 0.0),
+            _ => Vec3::new(rng(s) * 6.0 - 0.5, rng(s) * 6.0 - 0.5, rng(s) * 4.0 - 2.0),
+        };
+        let o = match i % 5 {
+            0 => Vec3::new(target.x, target.y, 3.0), // axis-aligned, exactly through it
+            1 => Vec3::new(rng(s) * 6.0, rng(s) * 6.0, 0.0), // on the grid's plane
+            _ => Vec3::new(rng(s) * 10.0 - 2.0, rng(s) * 10.0 - 2.0, rng(s) * 8.0 - 4.0),
+        };
+        let d = target - o;
+        let t_max = [f32::INFINITY, 1.0, 0.5, 1e-3][(i % 4) as usize];
+        (TriangleRay::new(o, d), t_max)
+    }
+
+    #[test]
+    fn answers_as_the_per_triangle_test_in_record_order() {
+        let mut s = 0x5DEE_CE66_D1CE_4E5Bu64;
+        let (mut hits, mut misses, mut occluded) = (0, 0, 0);
+        // Record counts that fill chunks exactly, leave one lane, and leave most empty.
+        for (k, extra) in [14usize, 15, 0, 3].into_iter().enumerate() {
+            let records = scene(extra, &mut s);
+            let flat = FlatTriangles::new(&records);
+            for i in 0..50_000u32 {
+                let (r, t_max) = ray(i + k as u32, &mut s);
+                if r.d.length_squared() == 0.0 {
+                    continue;
+                }
+                let expected = scan(&records, &r, t_max);
+                let found = flat.closest(&records, &r, t_max).map(|(i, h)| (i, h.t));
+                assert_eq!(found, expected, "ray {i} of scene {k}");
+                assert_eq!(flat.any(&records, &r, t_max), expected.is_some());
+                hits += expected.is_some() as u32;
+                misses += expected.is_none() as u32;
+                occluded += (expected.is_some() && t_max.is_finite()) as u32;
+            }
+        }
+        // The rays exercise both outcomes, including segments that end before a hit.
+        assert!(hits > 40_000 && misses > 40_000 && occluded > 10_000);
+    }
+
+    #[test]
+    fn lane_filter_keeps_every_lane_the_triangle_test_accepts() {
+        // Stronger than the agreement above: the filter alone never drops an accepted
+        // triangle, lane by lane, and (where AVX-512 is compiled) both versions agree.
+        let mut s = 0xA076_1D64_78BD_642Fu64;
+        let records = scene(14, &mut s);
+        let flat = FlatTriangles::new(&records);
+        let mut accepted = 0;
+        for i in 0..50_000u32 {
+            let (r, t_max) = ray(i, &mut s);
+            if r.d.length_squared() == 0.0 {
+                continue;
+            }
+            for (c, chunk) in flat.chunks.iter().enumerate() {
+                let mask = candidates(chunk, &r, t_max) & flat.lane_mask(c);
+                assert_eq!(
+                    mask,
+                    candidates_portable(chunk, &r, t_max) & flat.lane_mask(c)
+                );
+                for lane in 0..LANES.min(records.len() - c * LANES) {
+                    let rec = &records[c * LANES + lane];
+                    if triangle::intersect(rec, &r, t_max).is_some() {
+                        accepted += 1;
+                        assert!(mask & (1 << lane) != 0, "ray {i} lane {lane} dropped");
+                    }
+                }
+            }
+        }
+        assert!(accepted > 20_000);
+    }
+
+    #[test]
+    fn agrees_with_the_tree_on_the_cornell_box() {
+        use crate::geometry::bvh::{TraversalRay, TriangleBvh, TriangleList};
+        use crate::geometry::procedural::cornell_box;
+        use crate::scene::ShapeGeometry;
+        let mut vertices = Vec::new();
+        for shape in cornell_box(2.0) {
+            if let ShapeGeometry::Mesh(m) = &shape.geometry {
+                vertices.extend(m.indices.iter().map(|t| t.map(|i| m.positions[i as usize])));
+            }
+        }
+        let ids: Vec<[u32; 2]> = (0..vertices.len() as u32).map(|i| [0, i]).collect();
+        let list = TriangleList {
+            vertices: &vertices,
+            ids: &ids,
+        };
+        let tree = TriangleBvh::build_with_flat_limit(&list, 0);
+        let flat = TriangleBvh::build_with_flat_limit(&list, usize::MAX);
+        let mut s = 0x2545_F491_4F6C_DD1Du64;
+        let mut hits = 0;
+        for i in 0..100_000u32 {
+            let o = Vec3::new(rng(&mut s), rng(&mut s), rng(&mut s)) * 2.4 - 0.2;
+            let d = Vec3::new(rng(&mut s), rng(&mut s), rng(&mut s)) * 2.0 - 1.0;
+            if d.length_squared() == 0.0 {
+                continue;
+            }
+            let r = TraversalRay::new(o, d);
+            let t_max = [f32::INFINITY, 0.3][(i % 2) as usize];
+            // Same distance; the triangle may differ only between hits at equal t.
+            let a = tree.closest(&r, t_max).map(|(_, h)| h.t.to_bits());
+            let b = flat.closest(&r, t_max).map(|(_, h)| h.t.to_bits());
+            assert_eq!(a, b, "ray {i}");
+            assert_eq!(tree.any(&r, t_max), flat.any(&r, t_max), "ray {i}");
+            hits += a.is_some() as u32;
+        }
+        // Half the rays are long enough to hit a wall (the box is open at the front).
+        assert!(hits > 40_000, "{hits} hits");
+    }
+}
