@@ -54,6 +54,23 @@ class Failure(Exception):
 # ---------------------------------------------------------------- worker (child process)
 
 
+def set_llvm_lanes(lanes):
+    """Makes Dr.Jit's LLVM backend compile `lanes`-wide kernels for an AVX2 CPU, as on a
+    machine without AVX-512 (16 lanes there). Dr.Jit does not expose its
+    `jit_llvm_set_target(cpu, features, vector_width)` to Python; it is called from the
+    core library directly, before any kernel is compiled."""
+    import ctypes
+    import drjit as dr
+
+    core = ctypes.CDLL(str(Path(dr.__file__).parent / "libdrjit-core.so"))
+    try:
+        set_target = getattr(core, "_Z19jit_llvm_set_targetPKcS0_j")  # C++ mangled name
+    except AttributeError:
+        raise SystemExit(f"--llvm-lanes: this Dr.Jit ({dr.__version__}) has no jit_llvm_set_target")
+    set_target.argtypes = [ctypes.c_char_p, ctypes.c_char_p, ctypes.c_uint]
+    set_target(b"haswell", b"+avx2,+fma,+f16c,+bmi,+bmi2,+lzcnt,+popcnt", lanes)
+
+
 def worker(job_file):
     """Render one scene with one Mitsuba variant at each spp of the job; write EXRs + JSON."""
     job = json.loads(Path(job_file).read_text())
@@ -63,6 +80,8 @@ def worker(job_file):
 
     mi.set_variant(job["variant"])
     mi.set_log_level(mi.LogLevel.Warn)
+    if job.get("llvm_lanes") and job["variant"].startswith("llvm"):
+        set_llvm_lanes(job["llvm_lanes"])
     # The pool's size counts the calling thread, which works too: T means T busy threads.
     dr.set_thread_count(job["threads"])
     scene_path = job["scene"]
@@ -133,6 +152,7 @@ def run_mitsuba(args, variant, spps, outdir):
         "scene": str(args.scene),
         "variant": variant,
         "threads": args.threads,
+        "llvm_lanes": args.llvm_lanes,
         "seed": args.seed,
         "spps": spps,
         "defines": args.defines,
@@ -421,6 +441,13 @@ def parse_args(argv):
     p.add_argument("--threads", type=int, default=2, help="threads for both renderers (default 2)")
     p.add_argument("--seed", type=int, default=0, help="seed for both renderers (default 0)")
     p.add_argument(
+        "--llvm-lanes",
+        type=int,
+        choices=[4, 8],
+        help="compile llvm_ad_rgb's kernels 4 or 8 lanes wide for AVX2 (default: Dr.Jit's "
+        "choice for this CPU, 16 lanes with AVX-512)",
+    )
+    p.add_argument(
         "-D",
         "--define",
         action="append",
@@ -552,6 +579,8 @@ def crosscheck(args, outdir):
                 raise Failure(f"image sizes differ: mltbench {x.shape[1]} x {x.shape[0]}, "
                               f"Mitsuba {y.shape[1]} x {y.shape[0]}")
             cmp = compare(x, y)
+            if args.llvm_lanes and v.startswith("llvm"):
+                v = f"{v} ({args.llvm_lanes} lanes)"
             mits_mps, mlt_mps = print_block(v, spp, cmp, m, mrun, mlt[spp], args.threads)
             tables.setdefault(v, []).append((spp, cmp["relmse"]))
             if args.csv:

@@ -21,9 +21,11 @@ use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord};
 /// Triangles per chunk: one AVX-512 register, or two AVX2 ones.
 const LANES: usize = 16;
 
-/// Scenes with at most this many triangles are answered by `FlatTriangles` (measured
-/// crossover with the tree: README "Performance").
-pub const FLAT_LIMIT: usize = 64;
+/// Scenes with at most this many triangles (three chunks) are answered by `FlatTriangles`.
+/// `cargo bench --bench rays -- flat_crossover` (one thread, incoherent rays): at 36
+/// triangles flat closest hits run 7% faster than the tree's, at 68 they are even and any
+/// hits 15% slower, at 132 both are 1.5–2× slower (README "Performance").
+pub const FLAT_LIMIT: usize = 48;
 
 /// Sixteen triangles, coordinates by axis, then vertex, then lane.
 #[derive(Clone, Copy)]
