@@ -151,8 +151,9 @@ pub struct TriangleBvh {
     depth: usize,
     bounds: (Vec3, Vec3),
     /// The records laid out for `flat.rs`, which answers the queries instead of the tree
-    /// when there are at most `FLAT_LIMIT` triangles.
-    flat: Option<FlatTriangles>,
+    /// when there are at most `FLAT_LIMIT` triangles (`nodes` is then empty; otherwise
+    /// this is).
+    flat: FlatTriangles,
 }
 
 impl TriangleBvh {
@@ -211,8 +212,14 @@ impl TriangleBvh {
                     .map(|&i| source.uvs(i as usize).unwrap_or([Vec2::NAN; 3])),
             )
         });
-        let nodes = collect_large(wide.nodes.par_iter().copied());
-        let flat = (records.len() <= flat_limit).then(|| FlatTriangles::new(&records));
+        // A flat scene keeps no nodes: `is_flat` is the emptiness test the tree's queries make
+        // anyway.
+        let (nodes, flat) = if records.len() <= flat_limit {
+            (Vec::new(), FlatTriangles::new(&records))
+        } else {
+            let nodes = collect_large(wide.nodes.par_iter().copied());
+            (nodes, FlatTriangles::default())
+        };
         TriangleBvh {
             nodes,
             flat,
@@ -249,11 +256,43 @@ impl TriangleBvh {
         self.nodes.len()
     }
 
+    /// True when the queries are answered without the tree (`flat.rs`): at most
+    /// `FLAT_LIMIT` triangles.
+    #[inline(always)]
+    pub fn is_flat(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
     /// Closest triangle with 0 < t < t_max: (record index, its hit data).
     #[inline(always)]
     pub fn closest(&self, ray: &TraversalRay, t_max: f32) -> Option<(u32, TriangleHit)> {
-        if let Some(flat) = &self.flat {
-            return flat.closest(&self.records, &ray.tri, t_max);
+        if self.is_flat() {
+            self.closest_in::<true>(ray, t_max)
+        } else {
+            self.closest_in::<false>(ray, t_max)
+        }
+    }
+
+    /// True when some triangle lies at 0 < t < t_max.
+    #[inline(always)]
+    pub fn any(&self, ray: &TraversalRay, t_max: f32) -> bool {
+        if self.is_flat() {
+            self.any_in::<true>(ray, t_max)
+        } else {
+            self.any_in::<false>(ray, t_max)
+        }
+    }
+
+    /// `closest` for a BVH whose `is_flat()` is `FLAT`, for callers that choose once and keep
+    /// the flat test's code out of the function that traverses the tree (`Geometry`).
+    #[inline(always)]
+    pub fn closest_in<const FLAT: bool>(
+        &self,
+        ray: &TraversalRay,
+        t_max: f32,
+    ) -> Option<(u32, TriangleHit)> {
+        if FLAT {
+            return self.flat.closest(&self.records, &ray.tri, t_max);
         }
         let mut visitor = Closest {
             bvh: self,
@@ -264,11 +303,11 @@ impl TriangleBvh {
         visitor.best
     }
 
-    /// True when some triangle lies at 0 < t < t_max.
+    /// `any` for a BVH whose `is_flat()` is `FLAT` (as `closest_in`).
     #[inline(always)]
-    pub fn any(&self, ray: &TraversalRay, t_max: f32) -> bool {
-        if let Some(flat) = &self.flat {
-            return flat.any(&self.records, &ray.tri, t_max);
+    pub fn any_in<const FLAT: bool>(&self, ray: &TraversalRay, t_max: f32) -> bool {
+        if FLAT {
+            return self.flat.any(&self.records, &ray.tri, t_max);
         }
         self.traverse_from_root(ray, t_max, &mut Any { bvh: self, ray })
     }
@@ -472,7 +511,7 @@ impl Default for TriangleBvh {
             uvs: None,
             depth: 0,
             bounds: (Vec3::INFINITY, Vec3::NEG_INFINITY),
-            flat: None,
+            flat: FlatTriangles::default(),
         }
     }
 }

@@ -62,7 +62,7 @@ impl TriangleBvh {
     ) {
         assert_eq!(rays.len(), t_max.len(), "one t_max per ray");
         // Small scenes answered without the tree, and trees too deep for the fixed stacks.
-        if self.nodes.is_empty() || self.flat.is_some() || self.depth >= FIXED_STACK {
+        if self.nodes.is_empty() || self.depth >= FIXED_STACK {
             for (i, ray) in rays.iter().enumerate() {
                 done(i, self.closest(ray, t_max[i]));
             }
