@@ -222,7 +222,7 @@ fn triangles_of(shapes: &[ShapeDesc]) -> Vec<[Vec3; 3]> {
 fn bench_flat_crossover(c: &mut Criterion) {
     let mut group = c.benchmark_group("flat_crossover");
     group.measurement_time(Duration::from_secs(3));
-    // Sphere rings × segments: 0, 32, 96 and 224 triangles beside the box's 32.
+    // Sphere rings × segments: 0, 32, 96 and 224 triangles beside the box's 36.
     for (rings, segments) in [(0u32, 0u32), (3, 8), (5, 12), (8, 16)] {
         let mut shapes = cornell_box(556.0);
         if rings > 0 {

@@ -56,19 +56,28 @@ class Failure(Exception):
 
 def set_llvm_lanes(lanes):
     """Makes Dr.Jit's LLVM backend compile `lanes`-wide kernels for an AVX2 CPU, as on a
-    machine without AVX-512 (16 lanes there). Dr.Jit does not expose its
+    machine without AVX-512 (16 lanes there). Only Dr.Jit's kernels: Mitsuba's ray tracing
+    (Embree) picks its own instruction set. Dr.Jit does not expose its
     `jit_llvm_set_target(cpu, features, vector_width)` to Python; it is called from the
-    core library directly, before any kernel is compiled."""
+    core library directly, before any kernel is compiled, and the width read back."""
     import ctypes
     import drjit as dr
 
-    core = ctypes.CDLL(str(Path(dr.__file__).parent / "libdrjit-core.so"))
+    def fail(why):
+        raise SystemExit(f"--llvm-lanes {lanes}: {why} (Dr.Jit {dr.__version__})")
+
     try:
-        set_target = getattr(core, "_Z19jit_llvm_set_targetPKcS0_j")  # C++ mangled name
-    except AttributeError:
-        raise SystemExit(f"--llvm-lanes: this Dr.Jit ({dr.__version__}) has no jit_llvm_set_target")
+        core = ctypes.CDLL(str(Path(dr.__file__).parent / "libdrjit-core.so"))
+        # C++ mangled names of jit_llvm_set_target and jit_llvm_vector_width.
+        set_target = getattr(core, "_Z19jit_llvm_set_targetPKcS0_j")
+        vector_width = getattr(core, "_Z21jit_llvm_vector_widthv")
+    except (OSError, AttributeError) as e:
+        fail(f"cannot reach Dr.Jit's LLVM target settings: {e}")
     set_target.argtypes = [ctypes.c_char_p, ctypes.c_char_p, ctypes.c_uint]
+    vector_width.restype = ctypes.c_uint32
     set_target(b"haswell", b"+avx2,+fma,+f16c,+bmi,+bmi2,+lzcnt,+popcnt", lanes)
+    if vector_width() != lanes:
+        fail(f"Dr.Jit kept {vector_width()} lanes (is its LLVM backend initialised?)")
 
 
 def worker(job_file):
@@ -481,6 +490,8 @@ def parse_args(argv):
         args.defines.append((name, value.strip()))
     if args.threads < 1:
         p.error("--threads must be at least 1")
+    if args.llvm_lanes and args.variant == "scalar_rgb":
+        p.error("--llvm-lanes sets llvm_ad_rgb's kernel width; scalar_rgb has no lanes")
     if not 0 <= args.seed < 1 << 32:
         p.error("--seed must be in [0, 2^32)")
     return args
@@ -537,7 +548,7 @@ def crosscheck(args, outdir):
     # Mitsuba first (one child per variant, all spp in it), then mltbench: never concurrently,
     # so the throughputs are measured on an otherwise idle machine.
     results = {}
-    if args.variant == "auto":
+    if args.variant == "auto" and not args.llvm_lanes:
         try:
             results["llvm_ad_rgb"] = run_mitsuba(args, "llvm_ad_rgb", args.spps, outdir)
         except Failure as e:
@@ -545,7 +556,9 @@ def crosscheck(args, outdir):
             print("note: falling back to scalar_rgb", flush=True)
             results["scalar_rgb"] = run_mitsuba(args, "scalar_rgb", args.spps, outdir)
     else:
-        variants = ["llvm_ad_rgb", "scalar_rgb"] if args.variant == "both" else [args.variant]
+        # `auto` with --llvm-lanes: llvm_ad_rgb or a clear failure, never a silent fallback.
+        variant = "llvm_ad_rgb" if args.variant == "auto" else args.variant
+        variants = ["llvm_ad_rgb", "scalar_rgb"] if variant == "both" else [variant]
         for v in variants:
             results[v] = run_mitsuba(args, v, args.spps, outdir)
     mlt = {spp: run_mltbench(args, spp, outdir) for spp in args.spps}

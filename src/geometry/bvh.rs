@@ -252,6 +252,7 @@ impl TriangleBvh {
         (!uv[0].is_nan()).then_some(uv)
     }
 
+    /// Number of wide nodes; 0 for a scene answered without the tree (`is_flat`).
     pub fn node_count(&self) -> usize {
         self.nodes.len()
     }
@@ -291,6 +292,11 @@ impl TriangleBvh {
         ray: &TraversalRay,
         t_max: f32,
     ) -> Option<(u32, TriangleHit)> {
+        debug_assert_eq!(
+            FLAT,
+            self.is_flat(),
+            "closest_in for the other kind of scene"
+        );
         if FLAT {
             return self.flat.closest(&self.records, &ray.tri, t_max);
         }
@@ -306,6 +312,7 @@ impl TriangleBvh {
     /// `any` for a BVH whose `is_flat()` is `FLAT` (as `closest_in`).
     #[inline(always)]
     pub fn any_in<const FLAT: bool>(&self, ray: &TraversalRay, t_max: f32) -> bool {
+        debug_assert_eq!(FLAT, self.is_flat(), "any_in for the other kind of scene");
         if FLAT {
             return self.flat.any(&self.records, &ray.tri, t_max);
         }
@@ -804,22 +811,27 @@ mod tests {
             [Vec3::Z, Vec3::Z + Vec3::X, Vec3::Z + Vec3::Y],
         ];
         let ids = [[0, 0], [0, 1]];
-        let bvh = TriangleBvh::build(&TriangleList {
+        let list = TriangleList {
             vertices: &tris,
             ids: &ids,
-        });
-        for (o, d, expected) in [
-            (Vec3::new(0.2, 0.2, 2.0), -Vec3::Z, 1),
-            (Vec3::new(0.2, 0.2, 2.0), Vec3::new(0.0, -0.0, -1.0), 1),
-            (Vec3::new(0.2, 0.2, -1.0), Vec3::new(-0.0, -0.0, 1.0), 0),
-            (Vec3::new(0.2, 0.2, 0.5), Vec3::new(-0.0, 0.0, -1.0), 0),
-        ] {
-            let hit = bvh.closest(&TraversalRay::new(o, d), f32::INFINITY);
-            assert_eq!(
-                hit.map(|(id, _)| bvh.record(id).ids()[1]),
-                Some(expected),
-                "{o} {d}"
-            );
+        };
+        // Through the tree (the slab planes chosen by sign), and without it.
+        for flat_limit in [0, usize::MAX] {
+            let bvh = TriangleBvh::build_with_flat_limit(&list, flat_limit);
+            assert_eq!(bvh.is_flat(), flat_limit > 0);
+            for (o, d, expected) in [
+                (Vec3::new(0.2, 0.2, 2.0), -Vec3::Z, 1),
+                (Vec3::new(0.2, 0.2, 2.0), Vec3::new(0.0, -0.0, -1.0), 1),
+                (Vec3::new(0.2, 0.2, -1.0), Vec3::new(-0.0, -0.0, 1.0), 0),
+                (Vec3::new(0.2, 0.2, 0.5), Vec3::new(-0.0, 0.0, -1.0), 0),
+            ] {
+                let hit = bvh.closest(&TraversalRay::new(o, d), f32::INFINITY);
+                assert_eq!(
+                    hit.map(|(id, _)| bvh.record(id).ids()[1]),
+                    Some(expected),
+                    "{o} {d}, flat limit {flat_limit}"
+                );
+            }
         }
     }
 }

@@ -210,8 +210,9 @@ fn candidates_portable(c: &Chunk, r: &TriangleRay, t_max: f32) -> u32 {
         } else {
             (t_num, det)
         };
-        // False for NaN edge functions (padding lanes, non-finite vertices), which the
-        // per-triangle test rejects too; they count as non-zero, so they are dropped here.
+        // False when det or T is NaN. Such a lane with no zero edge function (padding
+        // lanes; overflowing coordinates) is dropped, as the per-triangle test rejects it
+        // (its det is NaN too); one with a zero edge is kept by `!all_nonzero`, for f64.
         let in_range = (t_num_p > 0.0) & (t_num_p < t_max * det_p);
         let keep = !(any_neg & any_pos) & (!all_nonzero | in_range);
         mask |= (keep as u32) << i;
@@ -382,5 +383,46 @@ mod tests {
         }
         // Half the rays are long enough to hit a wall (the box is open at the front).
         assert!(hits > 40_000, "{hits} hits");
+    }
+
+    #[test]
+    fn odd_triangles_and_counts_answer_as_the_scan() {
+        // Zero-area, huge (overflowing the edge functions), infinite and NaN vertices, at
+        // 0, 1, 16, 48 and 49 triangles, with rays of every length including 0 and NaN.
+        let mut s = 0x853C_49E6_748F_EA9Bu64;
+        let odd = [0.0, -0.0, 1e-40, 3e38, -3e38, f32::INFINITY, f32::NAN];
+        let mut checked = 0;
+        for count in [0usize, 1, 16, 48, 49] {
+            let records: Vec<TriangleRecord> = (0..count as u32)
+                .map(|i| {
+                    let mut v = || Vec3::new(rng(&mut s), rng(&mut s), rng(&mut s)) * 4.0 - 2.0;
+                    let mut tri = [v(), v(), v()];
+                    match i % 5 {
+                        0 => tri[2] = tri[0] + (tri[1] - tri[0]) * 0.5, // zero area
+                        1 => tri[1].x = odd[(rng(&mut s) * 7.0) as usize],
+                        2 => tri[0] *= 1e30, // large, finite
+                        _ => {}
+                    }
+                    TriangleRecord::new(tri, 0, i)
+                })
+                .collect();
+            let flat = FlatTriangles::new(&records);
+            for i in 0..20_000u32 {
+                let o = Vec3::new(rng(&mut s), rng(&mut s), rng(&mut s)) * 6.0 - 3.0;
+                let d = Vec3::new(rng(&mut s), rng(&mut s), rng(&mut s)) * 2.0 - 1.0;
+                if d.length_squared() == 0.0 {
+                    continue;
+                }
+                let r = TriangleRay::new(o, d);
+                let t_max = [f32::INFINITY, 1.0, 0.0, f32::NAN][(i % 4) as usize];
+                let expected = scan(&records, &r, t_max);
+                let found = flat.closest(&records, &r, t_max).map(|(i, h)| (i, h.t));
+                assert_eq!(found, expected, "{count} triangles, ray {i}");
+                assert_eq!(flat.any(&records, &r, t_max), expected.is_some());
+                checked += expected.is_some() as u32;
+            }
+        }
+        // Half the segments are empty (t_max 0 or NaN), and the triangles are small.
+        assert!(checked > 2_000, "{checked} hits");
     }
 }
