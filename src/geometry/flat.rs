@@ -38,14 +38,14 @@ struct Chunk {
 #[derive(Clone, Default)]
 pub struct FlatTriangles {
     chunks: Vec<Chunk>,
-    count: usize,
 }
 
 impl FlatTriangles {
     pub fn new(records: &[TriangleRecord]) -> FlatTriangles {
         let mut chunks = Vec::with_capacity(records.len().div_ceil(LANES));
         for group in records.chunks(LANES) {
-            // Lanes past the end hold NaN; `lane_mask` keeps them out anyway.
+            // Lanes past the end hold NaN: all their edge functions are NaN, which
+            // `candidates` drops.
             let mut c = Chunk {
                 v: [[[f32::NAN; LANES]; 3]; 3],
             };
@@ -58,10 +58,7 @@ impl FlatTriangles {
             }
             chunks.push(c);
         }
-        FlatTriangles {
-            chunks,
-            count: records.len(),
-        }
+        FlatTriangles { chunks }
     }
 
     /// The closest triangle with 0 < t < t_max: (record index, its hit data), as
@@ -75,7 +72,7 @@ impl FlatTriangles {
     ) -> Option<(u32, TriangleHit)> {
         let mut best = None;
         for (c, chunk) in self.chunks.iter().enumerate() {
-            let mut lanes = candidates(chunk, r, t_max) & self.lane_mask(c);
+            let mut lanes = candidates(chunk, r, t_max);
             while lanes != 0 {
                 let index = c * LANES + lanes.trailing_zeros() as usize;
                 lanes &= lanes - 1;
@@ -92,7 +89,7 @@ impl FlatTriangles {
     #[inline(always)]
     pub fn any(&self, records: &[TriangleRecord], r: &TriangleRay, t_max: f32) -> bool {
         for (c, chunk) in self.chunks.iter().enumerate() {
-            let mut lanes = candidates(chunk, r, t_max) & self.lane_mask(c);
+            let mut lanes = candidates(chunk, r, t_max);
             while lanes != 0 {
                 let index = c * LANES + lanes.trailing_zeros() as usize;
                 lanes &= lanes - 1;
@@ -102,17 +99,6 @@ impl FlatTriangles {
             }
         }
         false
-    }
-
-    /// The lanes of chunk `c` that hold triangles.
-    #[inline(always)]
-    fn lane_mask(&self, c: usize) -> u32 {
-        let filled = self.count - c * LANES;
-        if filled >= LANES {
-            (1 << LANES) - 1
-        } else {
-            (1 << filled) - 1
-        }
     }
 }
 
@@ -320,21 +306,23 @@ mod tests {
         // Stronger than the agreement above: the filter alone never drops an accepted
         // triangle, lane by lane, and (where AVX-512 is compiled) both versions agree.
         let mut s = 0xA076_1D64_78BD_642Fu64;
-        let records = scene(14, &mut s);
-        let flat = FlatTriangles::new(&records);
         let mut accepted = 0;
+        // 64 triangles (full chunks) and 53 (eleven padding lanes).
+        let scenes = [scene(14, &mut s), scene(3, &mut s)];
+        let flats = scenes.each_ref().map(|records| FlatTriangles::new(records));
         for i in 0..50_000u32 {
+            let (records, flat) = (&scenes[(i % 2) as usize], &flats[(i % 2) as usize]);
             let (r, t_max) = ray(i, &mut s);
             if r.d.length_squared() == 0.0 {
                 continue;
             }
             for (c, chunk) in flat.chunks.iter().enumerate() {
-                let mask = candidates(chunk, &r, t_max) & flat.lane_mask(c);
-                assert_eq!(
-                    mask,
-                    candidates_portable(chunk, &r, t_max) & flat.lane_mask(c)
-                );
-                for lane in 0..LANES.min(records.len() - c * LANES) {
+                let mask = candidates(chunk, &r, t_max);
+                assert_eq!(mask, candidates_portable(chunk, &r, t_max));
+                // Padding lanes (NaN) are never candidates.
+                let filled = LANES.min(records.len() - c * LANES);
+                assert_eq!(mask >> filled, 0, "ray {i}: a padding lane kept");
+                for lane in 0..filled {
                     let rec = &records[c * LANES + lane];
                     if triangle::intersect(rec, &r, t_max).is_some() {
                         accepted += 1;
