@@ -10,8 +10,8 @@
 //! The lanes compute exactly the arithmetic of the watertight test (`triangle.rs`, same
 //! operations in the same order, no fused multiply-adds), and use it only as a filter: a
 //! lane whose edge functions have mixed signs, or whose t lies outside (0, t_max), cannot
-//! pass that test and is dropped. The few that remain (usually one or two per ray) go
-//! through `triangle::intersect` itself, which settles zero edge functions in f64 and the
+//! pass that test and is dropped. The few that remain (the triangles the ray crosses within
+//! the segment) go through `triangle::intersect` itself, which settles zero edge functions in f64 and the
 //! sign of t near the origin. So this path reports a hit exactly when the per-triangle test
 //! does; only the choice between hits at exactly equal t can differ from the tree's (here
 //! the lowest record index wins).
