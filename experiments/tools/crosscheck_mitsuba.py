@@ -146,7 +146,7 @@ def worker(job_file):
         t0 = time.perf_counter()
         img, passes = render(spp)
         seconds = time.perf_counter() - t0
-        exr = Path(job["outdir"]) / f"mitsuba-{job['variant']}-spp{spp}.exr"
+        exr = Path(job["outdir"]) / f"mitsuba-{job['name']}-spp{spp}.exr"
         mi.Bitmap(img).write(str(exr))
         out["runs"].append({"spp": spp, "seconds": seconds, "passes": passes, "exr": str(exr)})
     Path(job["result"]).write_text(json.dumps(out))
@@ -157,19 +157,24 @@ def worker(job_file):
 
 def run_mitsuba(args, variant, spps, outdir):
     """Run the worker for one variant; returns its JSON result or raises Failure."""
+    # Files named by variant, and lane count when set (a --keep DIR may hold other runs).
+    name = variant
+    if args.llvm_lanes and variant.startswith("llvm"):
+        name = f"{variant}-{args.llvm_lanes}lanes"
     job = {
         "scene": str(args.scene),
         "variant": variant,
+        "name": name,
         "threads": args.threads,
         "llvm_lanes": args.llvm_lanes,
         "seed": args.seed,
         "spps": spps,
         "defines": args.defines,
         "outdir": str(outdir),
-        "result": str(outdir / f"mitsuba-{variant}.json"),
+        "result": str(outdir / f"mitsuba-{name}.json"),
     }
     Path(job["result"]).unlink(missing_ok=True)  # a --keep DIR may hold an older one
-    job_file = outdir / f"job-{variant}.json"
+    job_file = outdir / f"job-{name}.json"
     job_file.write_text(json.dumps(job))
     proc = subprocess.run(
         [sys.executable, str(Path(__file__).resolve()), "--_worker", str(job_file)],
