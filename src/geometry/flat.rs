@@ -224,6 +224,11 @@ mod tests {
         (*state >> 40) as f32 / (1u64 << 24) as f32
     }
 
+    /// A point uniform in [−offset, scale − offset)³.
+    fn random_point(s: &mut u64, scale: f32, offset: f32) -> Vec3 {
+        Vec3::new(rng(s), rng(s), rng(s)) * scale - offset
+    }
+
     /// The per-triangle test over all records in order, keeping the first of the closest.
     fn scan(records: &[TriangleRecord], r: &TriangleRay, mut t_max: f32) -> Option<(u32, f32)> {
         let mut best = None;
@@ -355,8 +360,8 @@ mod tests {
         let mut s = 0x2545_F491_4F6C_DD1Du64;
         let mut hits = 0;
         for i in 0..100_000u32 {
-            let o = Vec3::new(rng(&mut s), rng(&mut s), rng(&mut s)) * 2.4 - 0.2;
-            let d = Vec3::new(rng(&mut s), rng(&mut s), rng(&mut s)) * 2.0 - 1.0;
+            let o = random_point(&mut s, 2.4, 0.2);
+            let d = random_point(&mut s, 2.0, 1.0);
             if d.length_squared() == 0.0 {
                 continue;
             }
@@ -383,7 +388,7 @@ mod tests {
         for count in [0usize, 1, 16, 48, 49] {
             let records: Vec<TriangleRecord> = (0..count as u32)
                 .map(|i| {
-                    let mut v = || Vec3::new(rng(&mut s), rng(&mut s), rng(&mut s)) * 4.0 - 2.0;
+                    let mut v = || random_point(&mut s, 4.0, 2.0);
                     let mut tri = [v(), v(), v()];
                     match i % 5 {
                         0 => tri[2] = tri[0] + (tri[1] - tri[0]) * 0.5, // zero area
@@ -396,8 +401,8 @@ mod tests {
                 .collect();
             let flat = FlatTriangles::new(&records);
             for i in 0..20_000u32 {
-                let o = Vec3::new(rng(&mut s), rng(&mut s), rng(&mut s)) * 6.0 - 3.0;
-                let d = Vec3::new(rng(&mut s), rng(&mut s), rng(&mut s)) * 2.0 - 1.0;
+                let o = random_point(&mut s, 6.0, 3.0);
+                let d = random_point(&mut s, 2.0, 1.0);
                 if d.length_squared() == 0.0 {
                     continue;
                 }
