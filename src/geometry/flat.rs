@@ -8,13 +8,15 @@
 //! "Performance").
 //!
 //! The lanes compute exactly the arithmetic of the watertight test (`triangle.rs`, same
-//! operations in the same order, no fused multiply-adds), and use it only as a filter: a
-//! lane whose edge functions have mixed signs, or whose t lies outside (0, t_max), cannot
-//! pass that test and is dropped. The few that remain (the triangles the ray crosses within
-//! the segment) go through `triangle::intersect` itself, which settles zero edge functions in f64 and the
-//! sign of t near the origin. So this path reports a hit exactly when the per-triangle test
-//! does; only the choice between hits at exactly equal t can differ from the tree's (here
-//! the lowest record index wins).
+//! operations in the same order, no fused multiply-adds). A lane whose edge functions have
+//! mixed signs, or whose t lies outside (0, t_max), cannot pass that test and is dropped.
+//! A lane that remains with no zero edge function and T above its rounding error bound is
+//! settled: its hit follows from the lane's values through the test's last step (the
+//! division and the t < t_max check, `triangle::hit_from`). The others (zero edge functions,
+//! decided in f64; T too close to 0 for its sign to be certain) go through
+//! `triangle::intersect` itself. So this path reports a hit exactly when the per-triangle
+//! test does, with the same t and edge functions; only the choice between hits at exactly
+//! equal t can differ from the tree's (here the lowest record index wins).
 
 use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord};
 
@@ -45,7 +47,7 @@ impl FlatTriangles {
         let mut chunks = Vec::with_capacity(records.len().div_ceil(LANES));
         for group in records.chunks(LANES) {
             // Lanes past the end hold NaN: all their edge functions are NaN, which
-            // `candidates` drops.
+            // `lane_tests` drops.
             let mut c = Chunk {
                 v: [[[f32::NAN; LANES]; 3]; 3],
             };
@@ -72,11 +74,13 @@ impl FlatTriangles {
     ) -> Option<(u32, TriangleHit)> {
         let mut best = None;
         for (c, chunk) in self.chunks.iter().enumerate() {
-            let mut lanes = candidates(chunk, r, t_max);
-            while lanes != 0 {
-                let index = c * LANES + lanes.trailing_zeros() as usize;
-                lanes &= lanes - 1;
-                if let Some(h) = triangle::intersect(&records[index], r, t_max) {
+            let lanes = lane_tests(chunk, r, t_max);
+            let mut keep = lanes.keep;
+            while keep != 0 {
+                let lane = keep.trailing_zeros() as usize;
+                keep &= keep - 1;
+                let index = c * LANES + lane;
+                if let Some(h) = lanes.hit(&records[index], r, lane, t_max) {
                     t_max = h.t;
                     best = Some((index as u32, h));
                 }
@@ -89,11 +93,15 @@ impl FlatTriangles {
     #[inline(always)]
     pub fn any(&self, records: &[TriangleRecord], r: &TriangleRay, t_max: f32) -> bool {
         for (c, chunk) in self.chunks.iter().enumerate() {
-            let mut lanes = candidates(chunk, r, t_max);
-            while lanes != 0 {
-                let index = c * LANES + lanes.trailing_zeros() as usize;
-                lanes &= lanes - 1;
-                if triangle::intersect(&records[index], r, t_max).is_some() {
+            let lanes = lane_tests(chunk, r, t_max);
+            let mut keep = lanes.keep;
+            while keep != 0 {
+                let lane = keep.trailing_zeros() as usize;
+                keep &= keep - 1;
+                if lanes
+                    .hit(&records[c * LANES + lane], r, lane, t_max)
+                    .is_some()
+                {
                     return true;
                 }
             }
@@ -102,16 +110,89 @@ impl FlatTriangles {
     }
 }
 
-/// Bit i set unless lane i certainly fails the watertight test within (0, t_max): its edge
-/// functions have mixed signs, or they are all non-zero and the hit's t lies outside the
-/// range. Lanes with a zero edge function stay set: `triangle::intersect` decides them in
-/// f64.
+/// What the lanes found for one chunk and one ray.
+#[repr(C, align(64))]
+struct LaneTests {
+    /// Edge functions and T = Σ e_i·z_i·s_z, exactly as the per-triangle test computes them.
+    e: [[f32; LANES]; 3],
+    t_num: [f32; LANES],
+    /// Bit i set unless lane i certainly fails the watertight test within (0, t_max): its
+    /// edge functions have mixed signs, or they are all non-zero and the hit's t lies
+    /// outside the range. Lanes with a zero edge function stay set: `triangle::intersect`
+    /// decides them in f64.
+    keep: u32,
+    /// The lanes of `keep` settled here: no zero edge function, and T above its rounding
+    /// error bound (so t > 0 without the f64 sign test). Their hit follows from `e` and
+    /// `t_num` through the per-triangle test's last step; the others go through the whole
+    /// test again.
+    settled: u32,
+}
+
+impl LaneTests {
+    /// `triangle::intersect(record, r, t_max)` for lane `lane` of `keep`, with `t_max` no
+    /// larger than the chunk was tested with.
+    #[inline(always)]
+    fn hit(
+        &self,
+        record: &TriangleRecord,
+        r: &TriangleRay,
+        lane: usize,
+        t_max: f32,
+    ) -> Option<TriangleHit> {
+        if self.settled >> lane & 1 == 0 {
+            return triangle::intersect(record, r, t_max);
+        }
+        let e = [self.e[0][lane], self.e[1][lane], self.e[2][lane]];
+        let det = (e[0] + e[1]) + e[2];
+        // T exceeds its error bound (`settled`): no bound can send it to the f64 test.
+        triangle::hit_from(record, r, self.t_num[lane], det, e, t_max, || {
+            f32::NEG_INFINITY
+        })
+    }
+}
+
+/// Sixteen lanes of f32, for `triangle::t_num_error_bound_in`.
+#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+#[derive(Clone, Copy)]
+struct Lanes(std::arch::x86_64::__m512);
+
+#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+impl std::ops::Add for Lanes {
+    type Output = Lanes;
+    #[inline(always)]
+    fn add(self, o: Lanes) -> Lanes {
+        // SAFETY: AVX-512F is enabled at compile time (cfg above).
+        Lanes(unsafe { std::arch::x86_64::_mm512_add_ps(self.0, o.0) })
+    }
+}
+
+#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+impl std::ops::Mul for Lanes {
+    type Output = Lanes;
+    #[inline(always)]
+    fn mul(self, o: Lanes) -> Lanes {
+        // SAFETY: as `add`.
+        Lanes(unsafe { std::arch::x86_64::_mm512_mul_ps(self.0, o.0) })
+    }
+}
+
+#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+impl triangle::BoundArithmetic for Lanes {
+    #[inline(always)]
+    fn splat(v: f32) -> Lanes {
+        // SAFETY: as `add`.
+        Lanes(unsafe { std::arch::x86_64::_mm512_set1_ps(v) })
+    }
+}
+
+/// The watertight test's arithmetic on the sixteen lanes of `c` (see `LaneTests`).
 #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
 #[inline(always)]
-fn candidates(c: &Chunk, r: &TriangleRay, t_max: f32) -> u32 {
+fn lane_tests(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
     use std::arch::x86_64::*;
-    // SAFETY: AVX-512F is enabled at compile time (cfg above); `Chunk` is 64-byte aligned
-    // and each row is 16 floats, so the aligned loads stay inside it.
+    // SAFETY: AVX-512F is enabled at compile time (cfg above); `Chunk` and `LaneTests` are
+    // 64-byte aligned and each row is 16 floats, so the aligned loads and stores stay
+    // inside them.
     unsafe {
         let load = |row: &[f32; LANES]| _mm512_load_ps(row.as_ptr());
         let splat = _mm512_set1_ps;
@@ -133,11 +214,10 @@ fn candidates(c: &Chunk, r: &TriangleRay, t_max: f32) -> u32 {
         let e1 = edge(x0, y2, y0, x2);
         let e2 = edge(x1, y0, y1, x0);
         let zero = _mm512_setzero_ps();
-        let lt = |e| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(e, zero);
-        let gt = |e| _mm512_cmp_ps_mask::<_CMP_GT_OQ>(e, zero);
+        let lt = |a, b| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(a, b);
         let ne = |e| _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(e, zero);
-        let any_neg = lt(e0) | lt(e1) | lt(e2);
-        let any_pos = gt(e0) | gt(e1) | gt(e2);
+        let any_neg = lt(e0, zero) | lt(e1, zero) | lt(e2, zero);
+        let any_pos = lt(zero, e0) | lt(zero, e1) | lt(zero, e2);
         let all_nonzero = ne(e0) & ne(e1) & ne(e2);
         let det = _mm512_add_ps(_mm512_add_ps(e0, e1), e2);
         let t_num = _mm512_add_ps(
@@ -156,21 +236,55 @@ fn candidates(c: &Chunk, r: &TriangleRay, t_max: f32) -> u32 {
             _mm512_and_si512(det_bits, sign),
         ));
         let det_p = _mm512_castsi512_ps(_mm512_andnot_si512(sign, det_bits));
-        let in_range = gt(t_num_p)
-            & _mm512_cmp_ps_mask::<_CMP_LT_OQ>(t_num_p, _mm512_mul_ps(splat(t_max), det_p));
-        (!(any_neg & any_pos) & (!all_nonzero | in_range)) as u32
+        let in_range = lt(zero, t_num_p) & lt(t_num_p, _mm512_mul_ps(splat(t_max), det_p));
+        let keep = !(any_neg & any_pos) & (!all_nonzero | in_range);
+        let mut out = LaneTests {
+            e: [[0.0; LANES]; 3],
+            t_num: [0.0; LANES],
+            keep: keep as u32,
+            settled: 0,
+        };
+        if keep == 0 {
+            // Most chunks: nothing crosses the segment.
+            return out;
+        }
+        // T's error bound from the largest |x|, |y|, |z| and |e|, as the per-triangle test
+        // computes it (exact maxima: the same values in any order).
+        let abs = |v| _mm512_abs_ps(v);
+        let max3 = |a, b, c| _mm512_max_ps(_mm512_max_ps(abs(a), abs(b)), abs(c));
+        let max_xy = _mm512_max_ps(max3(x0, x1, x2), max3(y0, y1, y2));
+        let bound = triangle::t_num_error_bound_in(
+            Lanes(max_xy),
+            Lanes(max3(z0, z1, z2)),
+            Lanes(max3(e0, e1, e2)),
+            Lanes(splat(r.sz.abs())),
+        )
+        .0;
+        let settled =
+            keep & all_nonzero & in_range & lt(bound, t_num_p) & lt(bound, splat(f32::INFINITY));
+        out.settled = settled as u32;
+        _mm512_store_ps(out.e[0].as_mut_ptr(), e0);
+        _mm512_store_ps(out.e[1].as_mut_ptr(), e1);
+        _mm512_store_ps(out.e[2].as_mut_ptr(), e2);
+        _mm512_store_ps(out.t_num.as_mut_ptr(), t_num);
+        out
     }
 }
 
-/// `candidates` in portable code (autovectorised), for targets without AVX-512.
+/// `lane_tests` in portable code (autovectorised), for targets without AVX-512.
 #[cfg_attr(
     all(target_arch = "x86_64", target_feature = "avx512f"),
     allow(dead_code)
 )]
 #[inline(always)]
-fn candidates_portable(c: &Chunk, r: &TriangleRay, t_max: f32) -> u32 {
+fn lane_tests_portable(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
     let (cx, cy, cz) = (&c.v[r.kx], &c.v[r.ky], &c.v[r.kz]);
-    let mut mask = 0u32;
+    let mut out = LaneTests {
+        e: [[0.0; LANES]; 3],
+        t_num: [0.0; LANES],
+        keep: 0,
+        settled: 0,
+    };
     for i in 0..LANES {
         // Sheared vertex coordinates, as `triangle::intersect_scalar`.
         let vertex = |j: usize| {
@@ -201,15 +315,28 @@ fn candidates_portable(c: &Chunk, r: &TriangleRay, t_max: f32) -> u32 {
         // (its det is NaN too); one with a zero edge is kept by `!all_nonzero`, for f64.
         let in_range = (t_num_p > 0.0) & (t_num_p < t_max * det_p);
         let keep = !(any_neg & any_pos) & (!all_nonzero | in_range);
-        mask |= (keep as u32) << i;
+        let max3 = |a: f32, b: f32, c: f32| a.abs().max(b.abs()).max(c.abs());
+        let bound = triangle::t_num_error_bound_in(
+            max3(x0, x1, x2).max(max3(y0, y1, y2)),
+            max3(z0, z1, z2),
+            max3(e0, e1, e2),
+            r.sz.abs(),
+        );
+        let settled = keep & all_nonzero & in_range & (t_num_p > bound) & (bound < f32::INFINITY);
+        out.keep |= (keep as u32) << i;
+        out.settled |= (settled as u32) << i;
+        out.e[0][i] = e0;
+        out.e[1][i] = e1;
+        out.e[2][i] = e2;
+        out.t_num[i] = t_num;
     }
-    mask
+    out
 }
 
 #[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f")))]
 #[inline(always)]
-fn candidates(c: &Chunk, r: &TriangleRay, t_max: f32) -> u32 {
-    candidates_portable(c, r, t_max)
+fn lane_tests(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
+    lane_tests_portable(c, r, t_max)
 }
 
 #[cfg(test)]
@@ -229,13 +356,22 @@ mod tests {
         Vec3::new(rng(s), rng(s), rng(s)) * scale - offset
     }
 
+    /// A hit's t, edge functions and determinant, as bits (NaN-safe equality).
+    fn bits(h: &TriangleHit) -> [u32; 5] {
+        [h.t, h.e[0], h.e[1], h.e[2], h.det].map(f32::to_bits)
+    }
+
     /// The per-triangle test over all records in order, keeping the first of the closest.
-    fn scan(records: &[TriangleRecord], r: &TriangleRay, mut t_max: f32) -> Option<(u32, f32)> {
+    fn scan(
+        records: &[TriangleRecord],
+        r: &TriangleRay,
+        mut t_max: f32,
+    ) -> Option<(u32, [u32; 5])> {
         let mut best = None;
         for (i, rec) in records.iter().enumerate() {
             if let Some(h) = triangle::intersect(rec, r, t_max) {
                 t_max = h.t;
-                best = Some((i as u32, h.t));
+                best = Some((i as u32, bits(&h)));
             }
         }
         best
@@ -294,7 +430,9 @@ mod tests {
                     continue;
                 }
                 let expected = scan(&records, &r, t_max);
-                let found = flat.closest(&records, &r, t_max).map(|(i, h)| (i, h.t));
+                let found = flat
+                    .closest(&records, &r, t_max)
+                    .map(|(i, h)| (i, bits(&h)));
                 assert_eq!(found, expected, "ray {i} of scene {k}");
                 assert_eq!(flat.any(&records, &r, t_max), expected.is_some());
                 hits += expected.is_some() as u32;
@@ -307,11 +445,11 @@ mod tests {
     }
 
     #[test]
-    fn lane_filter_keeps_every_lane_the_triangle_test_accepts() {
+    fn lanes_keep_every_triangle_the_test_accepts_and_settle_as_it() {
         // Stronger than the agreement above: the filter alone never drops an accepted
         // triangle, lane by lane, and (where AVX-512 is compiled) both versions agree.
         let mut s = 0xA076_1D64_78BD_642Fu64;
-        let mut accepted = 0;
+        let (mut accepted, mut settled) = (0, 0);
         // 64 triangles (full chunks) and 53 (eleven padding lanes).
         let scenes = [scene(14, &mut s), scene(3, &mut s)];
         let flats = scenes.each_ref().map(|records| FlatTriangles::new(records));
@@ -322,21 +460,48 @@ mod tests {
                 continue;
             }
             for (c, chunk) in flat.chunks.iter().enumerate() {
-                let mask = candidates(chunk, &r, t_max);
-                assert_eq!(mask, candidates_portable(chunk, &r, t_max));
+                let lanes = lane_tests(chunk, &r, t_max);
+                let portable = lane_tests_portable(chunk, &r, t_max);
+                assert_eq!(
+                    (lanes.keep, lanes.settled),
+                    (portable.keep, portable.settled)
+                );
                 // Padding lanes (NaN) are never candidates.
                 let filled = LANES.min(records.len() - c * LANES);
-                assert_eq!(mask >> filled, 0, "ray {i}: a padding lane kept");
+                assert_eq!(lanes.keep >> filled, 0, "ray {i}: a padding lane kept");
+                assert_eq!(lanes.settled & !lanes.keep, 0);
                 for lane in 0..filled {
                     let rec = &records[c * LANES + lane];
-                    if triangle::intersect(rec, &r, t_max).is_some() {
+                    let expected = triangle::intersect(rec, &r, t_max);
+                    if expected.is_some() {
                         accepted += 1;
-                        assert!(mask & (1 << lane) != 0, "ray {i} lane {lane} dropped");
+                        assert!(lanes.keep & (1 << lane) != 0, "ray {i} lane {lane} dropped");
                     }
+                    if lanes.keep & (1 << lane) == 0 {
+                        continue;
+                    }
+                    // A kept lane answers as the per-triangle test, also with a shorter
+                    // segment (as after a closer hit), whether settled here or not.
+                    for t in [t_max, t_max * 0.5] {
+                        for tests in [&lanes, &portable] {
+                            assert_eq!(
+                                tests.hit(rec, &r, lane, t).map(|h| bits(&h)),
+                                triangle::intersect(rec, &r, t).map(|h| bits(&h)),
+                                "ray {i} lane {lane}"
+                            );
+                        }
+                    }
+                    settled += lanes.settled >> lane & 1;
                 }
             }
         }
         assert!(accepted > 20_000);
+        // Most accepted lanes are settled by the lanes; the rest (zero edge functions, T
+        // within its error bound) are still exercised through the full test.
+        assert!(
+            settled > accepted / 2 && settled < accepted,
+            "{settled} of {accepted}"
+        );
     }
 
     #[test]
@@ -409,7 +574,9 @@ mod tests {
                 let r = TriangleRay::new(o, d);
                 let t_max = [f32::INFINITY, 1.0, 0.0, f32::NAN][(i % 4) as usize];
                 let expected = scan(&records, &r, t_max);
-                let found = flat.closest(&records, &r, t_max).map(|(i, h)| (i, h.t));
+                let found = flat
+                    .closest(&records, &r, t_max)
+                    .map(|(i, h)| (i, bits(&h)));
                 assert_eq!(found, expected, "{count} triangles, ray {i}");
                 assert_eq!(flat.any(&records, &r, t_max), expected.is_some());
                 checked += expected.is_some() as u32;

@@ -262,7 +262,7 @@ fn finish(
 /// exceeds its rounding error bound (`error_bound()`, evaluated only for candidates);
 /// otherwise it is decided in f64 (`t_is_positive`).
 #[inline(always)]
-fn hit_from(
+pub(super) fn hit_from(
     tri: &TriangleRecord,
     r: &TriangleRay,
     t_num: f32,
@@ -301,11 +301,38 @@ fn hit_from(
 /// T > bound, the exact T has the computed sign: t > 0 without the f64 test.
 #[inline(always)]
 fn t_num_error_bound(max_xy: f32, max_z: f32, max_e: f32, sz: f32) -> f32 {
-    let max_zs = max_z * sz.abs() * (1.0 + gamma(2));
-    let delta_xy = gamma(6) * (max_xy + 2.0 * max_z);
-    let delta_e = 2.0 * (gamma(2) * max_xy * max_xy + 2.0 * delta_xy * max_xy);
-    let delta_zs = gamma(3) * max_zs;
-    2.0 * 3.0 * (gamma(3) * max_e * max_zs + delta_e * max_zs + delta_zs * max_e)
+    t_num_error_bound_in(max_xy, max_z, max_e, sz.abs())
+}
+
+/// Arithmetic `t_num_error_bound_in` runs on: one f32, or sixteen lanes (`flat.rs`).
+pub(super) trait BoundArithmetic:
+    Copy + std::ops::Add<Output = Self> + std::ops::Mul<Output = Self>
+{
+    fn splat(v: f32) -> Self;
+}
+
+impl BoundArithmetic for f32 {
+    #[inline(always)]
+    fn splat(v: f32) -> f32 {
+        v
+    }
+}
+
+/// `t_num_error_bound` written once for scalars and lanes: the same operations in the same
+/// order (no fused multiply-adds), so both give the same bits.
+#[inline(always)]
+pub(super) fn t_num_error_bound_in<T: BoundArithmetic>(
+    max_xy: T,
+    max_z: T,
+    max_e: T,
+    abs_sz: T,
+) -> T {
+    let c = T::splat;
+    let max_zs = max_z * abs_sz * c(1.0 + gamma(2));
+    let delta_xy = c(gamma(6)) * (max_xy + c(2.0) * max_z);
+    let delta_e = c(2.0) * (c(gamma(2)) * max_xy * max_xy + c(2.0) * delta_xy * max_xy);
+    let delta_zs = c(gamma(3)) * max_zs;
+    c(2.0 * 3.0) * (c(gamma(3)) * max_e * max_zs + delta_e * max_zs + delta_zs * max_e)
 }
 
 /// The test with 4-wide SSE arithmetic (one lane per vertex); same results as
