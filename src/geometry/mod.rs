@@ -111,12 +111,14 @@ impl SurfaceInteraction {
     }
 
     /// A ray leaving the surface in direction `d`, origin offset to the side `d` points to.
+    #[inline]
     pub fn spawn_ray(&self, d: Vec3) -> Ray {
         Ray::new(offset_ray_origin(self.p, self.p_error, self.ng, d), d)
     }
 
     /// A ray from this surface towards point `target`, stopping just short of it:
     /// d = target − origin, t_max = 1 − SHADOW_EPSILON.
+    #[inline]
     pub fn spawn_ray_to(&self, target: Vec3) -> Ray {
         let o = offset_ray_origin(self.p, self.p_error, self.ng, target - self.p);
         Ray {

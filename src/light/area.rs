@@ -39,6 +39,7 @@ impl AreaLight {
         }
     }
 
+    #[inline]
     pub fn sample_li(&self, r: Vec3, u: Vec2) -> Option<LightSample> {
         let s = self.shape.sample_from(r, u)?;
         let d = s.point.p - r;

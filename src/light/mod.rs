@@ -376,6 +376,7 @@ impl Light {
     }
 
     /// A point of the light for next-event estimation from `ref_point`.
+    #[inline]
     pub fn sample_li(&self, ref_point: Vec3, u: Vec2) -> Option<LightSample> {
         let s = match self {
             Light::Area(l) => l.sample_li(ref_point, u),

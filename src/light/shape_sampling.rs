@@ -83,6 +83,7 @@ impl ShapeSampler {
     /// A point sampled for the reference point `r` (the strategy of the module docs).
     /// None when the point cannot be turned into a direction (it coincides with `r`, or is
     /// seen exactly edge-on).
+    #[inline]
     pub fn sample_from(&self, r: Vec3, u: Vec2) -> Option<ShapeSample> {
         if let ShapeSampler::Sphere(s) = self
             && s.sees_outside(r)
