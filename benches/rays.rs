@@ -10,6 +10,9 @@
 //! tree and without it (`geometry::flat`) on the Cornell box plus spheres of a few dozen
 //! to a few hundred triangles: where the two cross sets `flat::FLAT_LIMIT`.
 //!
+//! `rays/cornell_box/*` times `Geometry`'s queries on the Cornell box alone (one thread,
+//! incoherent rays), to compare with `experiments/tools/mitsuba_ray_rate.py`.
+//!
 //! `cargo bench --bench rays` (criterion prints rays/s as "elem/s"). Figures depend on the
 //! CPU features the build targets (`.cargo/config.toml`: target-cpu=native); state them
 //! with every figure (`rustc --print cfg -C target-cpu=native | grep feature`).
@@ -270,11 +273,49 @@ fn bench_flat_crossover(c: &mut Criterion) {
     group.finish();
 }
 
+/// The Cornell box alone (36 triangles, answered without the tree) through `Geometry`'s
+/// queries, one thread: the figures to set beside another renderer's ray casting on the
+/// same scene (`experiments/tools/mitsuba_ray_rate.py` casts the same kind of rays).
+fn bench_cornell_queries(c: &mut Criterion) {
+    let geometry = Geometry::build(&cornell_box(556.0));
+    let rays = incoherent_rays(&geometry, 1 << 18, 11);
+    // Segments ending halfway to the closest hit (rays that escape stay unbounded).
+    let shadow: Vec<Ray> = rays
+        .iter()
+        .map(|r| {
+            let t_max = geometry.closest_hit(r).map_or(r.t_max, |h| 0.5 * h.t);
+            Ray { t_max, ..*r }
+        })
+        .collect();
+    let mut group = c.benchmark_group("rays/cornell_box");
+    group
+        .measurement_time(Duration::from_secs(3))
+        .throughput(Throughput::Elements(rays.len() as u64));
+    group.bench_function("kernel_incoherent/1t", |b| {
+        b.iter(|| {
+            rays.iter()
+                .filter(|r| black_box(geometry.closest_hit(r)).is_some())
+                .count()
+        })
+    });
+    group.bench_function("closest_incoherent/1t", |b| {
+        b.iter(|| {
+            rays.iter()
+                .filter(|r| black_box(geometry.intersect(r)).is_some())
+                .count()
+        })
+    });
+    group.bench_function("anyhit_half_segments/1t", |b| {
+        b.iter(|| shadow.iter().filter(|r| geometry.occluded(r)).count())
+    });
+    group.finish();
+}
+
 criterion_group! {
     name = benches;
     // No HTML plots: mltbench builds plotters without system-font lookup (its plots embed a
     // font), and criterion's report plots would need one.
     config = Criterion::default().without_plots();
-    targets = bench_rays, bench_flat_crossover
+    targets = bench_rays, bench_flat_crossover, bench_cornell_queries
 }
 criterion_main!(benches);
