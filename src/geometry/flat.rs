@@ -153,35 +153,33 @@ impl LaneTests {
 
 /// Sixteen lanes of f32, for `triangle::t_num_error_bound_in`.
 #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-#[derive(Clone, Copy)]
-struct Lanes(std::arch::x86_64::__m512);
+mod lanes {
+    use std::arch::x86_64::*;
 
-#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-impl std::ops::Add for Lanes {
-    type Output = Lanes;
-    #[inline(always)]
-    fn add(self, o: Lanes) -> Lanes {
-        // SAFETY: AVX-512F is enabled at compile time (cfg above).
-        Lanes(unsafe { std::arch::x86_64::_mm512_add_ps(self.0, o.0) })
+    #[derive(Clone, Copy)]
+    pub(super) struct Lanes(pub __m512);
+
+    // SAFETY (every intrinsic below): AVX-512F is enabled at compile time (the module's
+    // cfg); register operations only.
+    macro_rules! lane_op {
+        ($op:ident, $method:ident, $intrinsic:ident) => {
+            impl std::ops::$op for Lanes {
+                type Output = Lanes;
+                #[inline(always)]
+                fn $method(self, o: Lanes) -> Lanes {
+                    Lanes(unsafe { $intrinsic(self.0, o.0) })
+                }
+            }
+        };
     }
-}
+    lane_op!(Add, add, _mm512_add_ps);
+    lane_op!(Mul, mul, _mm512_mul_ps);
 
-#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-impl std::ops::Mul for Lanes {
-    type Output = Lanes;
-    #[inline(always)]
-    fn mul(self, o: Lanes) -> Lanes {
-        // SAFETY: as `add`.
-        Lanes(unsafe { std::arch::x86_64::_mm512_mul_ps(self.0, o.0) })
-    }
-}
-
-#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-impl triangle::BoundArithmetic for Lanes {
-    #[inline(always)]
-    fn splat(v: f32) -> Lanes {
-        // SAFETY: as `add`.
-        Lanes(unsafe { std::arch::x86_64::_mm512_set1_ps(v) })
+    impl super::triangle::BoundArithmetic for Lanes {
+        #[inline(always)]
+        fn splat(v: f32) -> Lanes {
+            Lanes(unsafe { _mm512_set1_ps(v) })
+        }
     }
 }
 
@@ -189,6 +187,7 @@ impl triangle::BoundArithmetic for Lanes {
 #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
 #[inline(always)]
 fn lane_tests(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
+    use lanes::Lanes;
     use std::arch::x86_64::*;
     // SAFETY: AVX-512F is enabled at compile time (cfg above); `Chunk` and `LaneTests` are
     // 64-byte aligned and each row is 16 floats, so the aligned loads and stores stay
