@@ -376,6 +376,21 @@ mod tests {
         best
     }
 
+    /// Asserts that both of `flat`'s queries answer as the scan; returns the scan's answer.
+    fn answers_as_scan(
+        flat: &FlatTriangles,
+        records: &[TriangleRecord],
+        r: &TriangleRay,
+        t_max: f32,
+        what: &str,
+    ) -> Option<(u32, [u32; 5])> {
+        let expected = scan(records, r, t_max);
+        let found = flat.closest(records, r, t_max).map(|(i, h)| (i, bits(&h)));
+        assert_eq!(found, expected, "{what}");
+        assert_eq!(flat.any(records, r, t_max), expected.is_some(), "{what}");
+        expected
+    }
+
     /// A 5×5 grid of unit squares (50 triangles sharing edges and vertices at integer
     /// coordinates) in the plane z = 0, plus `extra` random triangles around it.
     fn scene(extra: usize, s: &mut u64) -> Vec<TriangleRecord> {
@@ -428,12 +443,8 @@ mod tests {
                 if r.d.length_squared() == 0.0 {
                     continue;
                 }
-                let expected = scan(&records, &r, t_max);
-                let found = flat
-                    .closest(&records, &r, t_max)
-                    .map(|(i, h)| (i, bits(&h)));
-                assert_eq!(found, expected, "ray {i} of scene {k}");
-                assert_eq!(flat.any(&records, &r, t_max), expected.is_some());
+                let expected =
+                    answers_as_scan(&flat, &records, &r, t_max, &format!("ray {i} of scene {k}"));
                 hits += expected.is_some() as u32;
                 misses += expected.is_none() as u32;
                 occluded += (expected.is_some() && t_max.is_finite()) as u32;
@@ -572,12 +583,8 @@ mod tests {
                 }
                 let r = TriangleRay::new(o, d);
                 let t_max = [f32::INFINITY, 1.0, 0.0, f32::NAN][(i % 4) as usize];
-                let expected = scan(&records, &r, t_max);
-                let found = flat
-                    .closest(&records, &r, t_max)
-                    .map(|(i, h)| (i, bits(&h)));
-                assert_eq!(found, expected, "{count} triangles, ray {i}");
-                assert_eq!(flat.any(&records, &r, t_max), expected.is_some());
+                let what = format!("{count} triangles, ray {i}");
+                let expected = answers_as_scan(&flat, &records, &r, t_max, &what);
                 checked += expected.is_some() as u32;
             }
         }
