@@ -360,6 +360,14 @@ mod tests {
         [h.t, h.e[0], h.e[1], h.e[2], h.det].map(f32::to_bits)
     }
 
+    /// An origin uniform in [−offset, scale − offset)³ and a direction uniform in
+    /// [−1, 1)³; None for a zero direction.
+    fn random_ray(s: &mut u64, scale: f32, offset: f32) -> Option<(Vec3, Vec3)> {
+        let o = random_point(s, scale, offset);
+        let d = random_point(s, 2.0, 1.0);
+        (d.length_squared() != 0.0).then_some((o, d))
+    }
+
     /// The per-triangle test over all records in order, keeping the first of the closest.
     fn scan(
         records: &[TriangleRecord],
@@ -535,11 +543,9 @@ mod tests {
         let mut s = 0x2545_F491_4F6C_DD1Du64;
         let mut hits = 0;
         for i in 0..100_000u32 {
-            let o = random_point(&mut s, 2.4, 0.2);
-            let d = random_point(&mut s, 2.0, 1.0);
-            if d.length_squared() == 0.0 {
+            let Some((o, d)) = random_ray(&mut s, 2.4, 0.2) else {
                 continue;
-            }
+            };
             let r = TraversalRay::new(o, d);
             let t_max = [f32::INFINITY, 0.3][(i % 2) as usize];
             // Same distance; the triangle may differ only between hits at equal t.
@@ -576,11 +582,9 @@ mod tests {
                 .collect();
             let flat = FlatTriangles::new(&records);
             for i in 0..20_000u32 {
-                let o = random_point(&mut s, 6.0, 3.0);
-                let d = random_point(&mut s, 2.0, 1.0);
-                if d.length_squared() == 0.0 {
+                let Some((o, d)) = random_ray(&mut s, 6.0, 3.0) else {
                     continue;
-                }
+                };
                 let r = TriangleRay::new(o, d);
                 let t_max = [f32::INFINITY, 1.0, 0.0, f32::NAN][(i % 4) as usize];
                 let what = format!("{count} triangles, ray {i}");
