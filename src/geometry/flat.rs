@@ -70,9 +70,34 @@ impl FlatTriangles {
         &self,
         records: &[TriangleRecord],
         r: &TriangleRay,
-        mut t_max: f32,
+        t_max: f32,
     ) -> Option<(u32, TriangleHit)> {
         let mut best = None;
+        self.hits(records, r, t_max, |index, h, t_max| {
+            *t_max = h.t;
+            best = Some((index as u32, h));
+            false
+        });
+        best
+    }
+
+    /// True when some triangle lies at 0 < t < t_max.
+    #[inline(always)]
+    pub fn any(&self, records: &[TriangleRecord], r: &TriangleRay, t_max: f32) -> bool {
+        self.hits(records, r, t_max, |_, _, _| true)
+    }
+
+    /// Hands every hit within (0, t_max) to `found(record index, hit, t_max)` in record
+    /// order, `t_max` as `found` leaves it (a closer hit shortens the segment); stops and
+    /// returns true when `found` does.
+    #[inline(always)]
+    fn hits(
+        &self,
+        records: &[TriangleRecord],
+        r: &TriangleRay,
+        mut t_max: f32,
+        mut found: impl FnMut(usize, TriangleHit, &mut f32) -> bool,
+    ) -> bool {
         for (c, chunk) in self.chunks.iter().enumerate() {
             let lanes = lane_tests(chunk, r, t_max);
             let mut keep = lanes.keep;
@@ -80,27 +105,8 @@ impl FlatTriangles {
                 let lane = keep.trailing_zeros() as usize;
                 keep &= keep - 1;
                 let index = c * LANES + lane;
-                if let Some(h) = lanes.hit(&records[index], r, lane, t_max) {
-                    t_max = h.t;
-                    best = Some((index as u32, h));
-                }
-            }
-        }
-        best
-    }
-
-    /// True when some triangle lies at 0 < t < t_max.
-    #[inline(always)]
-    pub fn any(&self, records: &[TriangleRecord], r: &TriangleRay, t_max: f32) -> bool {
-        for (c, chunk) in self.chunks.iter().enumerate() {
-            let lanes = lane_tests(chunk, r, t_max);
-            let mut keep = lanes.keep;
-            while keep != 0 {
-                let lane = keep.trailing_zeros() as usize;
-                keep &= keep - 1;
-                if lanes
-                    .hit(&records[c * LANES + lane], r, lane, t_max)
-                    .is_some()
+                if let Some(h) = lanes.hit(&records[index], r, lane, t_max)
+                    && found(index, h, &mut t_max)
                 {
                     return true;
                 }
