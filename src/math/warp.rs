@@ -35,12 +35,27 @@ pub fn square_to_disk_concentric(u: Vec2) -> Vec2 {
     if a == 0.0 && b == 0.0 {
         return Vec2::ZERO;
     }
-    let (r, phi) = if a * a > b * b {
-        (a, (PI / 4.0) * (b / a))
+    // φ = θ in the wedges around the x axis and φ = π/2 − θ in those around the y axis, with
+    // θ = (π/4)·(ratio of the two coordinates) in [−π/4, π/4] either way.
+    if a * a > b * b {
+        let (sin, cos) = sin_cos_quarter((PI / 4.0) * (b / a));
+        Vec2::new(a * cos, a * sin)
     } else {
-        (b, (PI / 2.0) - (PI / 4.0) * (a / b))
-    };
-    Vec2::new(r * phi.cos(), r * phi.sin())
+        let (sin, cos) = sin_cos_quarter((PI / 4.0) * (a / b));
+        Vec2::new(b * sin, b * cos)
+    }
+}
+
+/// (sin θ, cos θ) for θ in [−π/4, π/4], by polynomials fitted (least squares, in mltbench)
+/// to sin θ / θ and cos θ on that interval: both within 1e-7 of the exact values in f32,
+/// inline and without the range reduction of the general functions.
+#[inline]
+fn sin_cos_quarter(theta: f32) -> (f32, f32) {
+    let t2 = theta * theta;
+    let sin = theta * (1.0 + t2 * (-0.166_666_57 + t2 * (0.008_332_327 + t2 * -0.000_195_374_87)));
+    let cos =
+        1.0 + t2 * (-0.5 + t2 * (0.041_666_63 + t2 * (-0.001_388_697_9 + t2 * 0.000_024_410_747)));
+    (sin, cos)
 }
 
 /// Density of a uniform point on the unit disk: 1/π inside, 0 outside.
@@ -150,6 +165,20 @@ mod tests {
                 assert!(!upper || w.z >= 0.0);
             }
             assert!(square_to_uniform_cone(u, 0.8).z >= 0.8 - 1e-6);
+        }
+    }
+
+    /// The concentric map's polynomial sine and cosine stay within 2e-7 (under two f32
+    /// ulps at 1) of the double-precision functions over their whole interval.
+    #[test]
+    fn quarter_sin_cos_match_the_exact_functions() {
+        let n = 100_000;
+        for i in 0..=n {
+            let theta = (PI / 4.0) * (2.0 * i as f32 / n as f32 - 1.0);
+            let (sin, cos) = sin_cos_quarter(theta);
+            let t = theta as f64;
+            assert!((sin as f64 - t.sin()).abs() < 2e-7, "sin {theta}");
+            assert!((cos as f64 - t.cos()).abs() < 2e-7, "cos {theta}");
         }
     }
 
