@@ -185,21 +185,16 @@ fn run_render(args: RenderArgs) -> Result<()> {
     if args.spp == Some(0) {
         return Err(Error::usage("--spp must be at least 1"));
     }
+    estimator::check_name(&args.common.estimator)?;
     let output = args
         .output
         .clone()
         .unwrap_or_else(|| default_output(&args.common.scene));
-    if output.extension().and_then(|e| e.to_str()) != Some("exr") {
-        return Err(Error::usage(format!(
-            "output {} must end in .exr",
-            output.display()
-        )));
-    }
-
     // Refused now rather than after the render: its result would be lost.
-    io::atomic::check_writable(&output)?;
+    let preview = io::outputs::check_outputs(&output, &["png"])?.remove(0);
     let scene_params = parse_defines(&args.common.define)?;
     let description = mitsuba::load_file_with(&args.common.scene, &scene_params)?;
+    io::outputs::check_not_inputs([output.as_path(), &preview], &description.files_read)?;
     for warning in &description.warnings {
         eprintln!("warning: {warning}");
     }
@@ -239,7 +234,6 @@ fn run_render(args: RenderArgs) -> Result<()> {
     bar.finish_and_clear();
 
     io::exr::write_exr(&output, &result.image)?;
-    let preview = output.with_extension("png");
     io::png::write_png_preview(&preview, &result.image)?;
 
     let stats = &result.stats;
@@ -380,6 +374,7 @@ fn report_experiment(args: ReportArgs) -> Result<()> {
 
 fn render_reference(args: ReferenceArgs) -> Result<()> {
     Params::parse(&args.common.set)?; // rejects a malformed --set before any rendering
+    estimator::check_name(&args.common.estimator)?;
     let budget = match (args.spp, args.time) {
         (_, Some(t)) if t.is_finite() && t > 0.0 => Budget::Seconds(t),
         (Some(n), None) if n >= 2 => Budget::Passes(n),
@@ -398,11 +393,14 @@ fn render_reference(args: ReferenceArgs) -> Result<()> {
             .unwrap_or("scene");
         PathBuf::from(format!("{stem}-reference.exr"))
     });
-    io::atomic::check_writable(&output)?;
-    let scene = Scene::build(mitsuba::load_file_with(
-        &args.common.scene,
-        &parse_defines(&args.common.define)?,
-    )?)?;
+    // The EXR, its noise description and its preview (`reference::save`), checked before
+    // the render so that none of them is lost at the end or overwrites an input.
+    let sidecars = io::outputs::check_outputs(&output, &["json", "png"])?;
+    let scene_params = parse_defines(&args.common.define)?;
+    let description = mitsuba::load_file_with(&args.common.scene, &scene_params)?;
+    let outputs = std::iter::once(output.as_path()).chain(sidecars.iter().map(PathBuf::as_path));
+    io::outputs::check_not_inputs(outputs, &description.files_read)?;
+    let scene = Scene::build(description)?;
     let pool = thread_pool(args.common.threads)?;
     let bar = experiment_bar();
     let rendered = pool.install(|| {
@@ -432,7 +430,14 @@ fn render_reference(args: ReferenceArgs) -> Result<()> {
 fn compare(args: CompareArgs) -> Result<()> {
     let image = io::exr::read_exr(&args.image)?;
     let reference = experiment::reference::load(&args.reference)?;
-    let m = experiment::metrics::metrics(&image, &reference.image)?;
+    // The metrics' messages say "image" and "reference": name the two files.
+    let m = experiment::metrics::metrics(&image, &reference.image).map_err(|e| {
+        Error::usage(format!(
+            "{} against {}: {e}",
+            args.image.display(),
+            args.reference.display()
+        ))
+    })?;
     println!("relmse {:.6e}", m.relmse);
     println!("rmse   {:.6e}", m.rmse);
     println!("mape   {:.6e}", m.mape);
@@ -445,17 +450,21 @@ fn compare(args: CompareArgs) -> Result<()> {
     Ok(())
 }
 
-/// `NAME=VALUE` pairs of `-D`.
+/// `NAME=VALUE` pairs of `-D`; a name given twice is refused (as `--set` refuses it), since
+/// either value winning silently would surprise someone.
 fn parse_defines(defines: &[String]) -> Result<Vec<(String, String)>> {
-    defines
-        .iter()
-        .map(|d| match d.split_once('=') {
-            Some((name, value)) if !name.trim().is_empty() => {
-                Ok((name.trim().to_string(), value.trim().to_string()))
-            }
-            _ => Err(Error::usage(format!("-D expects NAME=VALUE, got '{d}'"))),
-        })
-        .collect()
+    let mut pairs: Vec<(String, String)> = Vec::with_capacity(defines.len());
+    for d in defines {
+        let Some((name, value)) = d.split_once('=').filter(|(n, _)| !n.trim().is_empty()) else {
+            return Err(Error::usage(format!("-D expects NAME=VALUE, got '{d}'")));
+        };
+        let name = name.trim();
+        if pairs.iter().any(|(n, _)| n == name) {
+            return Err(Error::usage(format!("-D {name} is given more than once")));
+        }
+        pairs.push((name.to_string(), value.trim().to_string()));
+    }
+    Ok(pairs)
 }
 
 /// `<scene file stem>.exr` in the working directory.

@@ -319,3 +319,112 @@ fn invalid_samples_are_counted_and_never_reach_the_film() {
     assert_eq!(good.count(), 64);
     assert!(image.pixels.iter().all(|p| p.is_valid_radiance()));
 }
+
+/// Runs `mltbench` in `dir` and returns its stderr after checking that it failed cleanly
+/// (non-zero exit, no panic).
+fn failure(args: &[&str], dir: &Path) -> String {
+    let run = mltbench(args, dir);
+    let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
+    assert!(!run.status.success(), "{args:?} succeeded");
+    assert!(!stderr.contains("panicked"), "{args:?}: {stderr}");
+    stderr
+}
+
+/// Outputs that would overwrite an input, land in the wrong format or fail after the render
+/// are refused before it; so are a `-D` given twice, an unknown estimator (before the scene
+/// is read) and `rr_depth` 0 from the command line.
+#[test]
+fn cli_refuses_outputs_that_would_lose_or_overwrite_files() {
+    let dir = temp_dir("outputs");
+    let mut sky = Image::new(8, 4);
+    sky.pixels.fill(mltbench::math::Rgb::splat(0.5));
+    mltbench::io::exr::write_exr(&dir.join("sky.exr"), &sky).unwrap();
+    let sky_bytes = std::fs::read(dir.join("sky.exr")).unwrap();
+    std::fs::write(
+        dir.join("scene.xml"),
+        r#"<scene version="3.0.0">
+    <integrator type="path"><integer name="max_depth" value="3"/></integrator>
+    <sensor type="perspective">
+        <film type="hdrfilm"><integer name="width" value="4"/><integer name="height" value="4"/></film>
+    </sensor>
+    <emitter type="envmap"><string name="filename" value="sky.exr"/></emitter>
+    <shape type="sphere"><point name="center" x="0" y="0" z="-5"/></shape>
+</scene>"#,
+    )
+    .unwrap();
+    std::fs::create_dir_all(dir.join("taken.json")).unwrap();
+    let render = |extra: &[&'static str]| {
+        let mut args = vec!["render", "scene.xml", "--estimator", "pt", "--spp", "1"];
+        args.extend_from_slice(extra);
+        args
+    };
+    let reference = |extra: &[&'static str]| {
+        let mut args = vec!["reference", "scene.xml", "--estimator", "pt", "--spp", "2"];
+        args.extend_from_slice(extra);
+        args
+    };
+    let cases: Vec<(Vec<&'static str>, &str)> = vec![
+        (render(&["-o", "sky.exr"]), "would overwrite the input"),
+        (reference(&["-o", "sky.exr"]), "would overwrite the input"),
+        (reference(&["-o", "out.json"]), "must end in .exr"),
+        (reference(&["-o", "out.png"]), "must end in .exr"),
+        (reference(&["-o", "taken.exr"]), "taken.json"),
+        (render(&["-D", "res=2", "-D", "res=6"]), "more than once"),
+        (render(&["--set", "rr_depth=0"]), "rr_depth"),
+        (
+            vec!["render", "missing.xml", "--estimator", "bogus"],
+            "unknown estimator 'bogus'",
+        ),
+    ];
+    for (args, needle) in cases {
+        let stderr = failure(&args, &dir);
+        assert!(stderr.contains(needle), "{args:?}: {stderr}");
+    }
+    assert_eq!(std::fs::read(dir.join("sky.exr")).unwrap(), sky_bytes);
+    for f in ["out.json", "out.png", "taken.exr", "scene.exr"] {
+        assert!(!dir.join(f).exists(), "{f} was written");
+    }
+}
+
+/// `compare` names the two files when they do not fit together, and refuses a reference
+/// description with a negative noise estimate or a key it does not know.
+#[test]
+fn cli_compare_names_its_files() {
+    let dir = temp_dir("compare");
+    let write = |name: &str, w: u32, h: u32| {
+        let mut image = Image::new(w, h);
+        image.pixels.fill(mltbench::math::Rgb::splat(1.0));
+        mltbench::io::exr::write_exr(&dir.join(name), &image).unwrap();
+    };
+    write("wide.exr", 8, 4);
+    write("square.exr", 8, 8);
+    let stderr = failure(&["compare", "wide.exr", "square.exr"], &dir);
+    assert!(
+        stderr.contains("wide.exr") && stderr.contains("square.exr"),
+        "{stderr}"
+    );
+    write("ref.exr", 8, 4);
+    let valid = r#"{"key": "", "scene": "s.xml", "estimator": "pt", "params": [], "passes": 2,
+        "samples": 64, "seconds": 1.0, "seed": 1, "noise_relmse": 0.001}"#;
+    std::fs::write(dir.join("ref.json"), valid).unwrap();
+    let ok = mltbench(&["compare", "wide.exr", "ref.exr"], &dir);
+    assert!(
+        ok.status.success(),
+        "{}",
+        String::from_utf8_lossy(&ok.stderr)
+    );
+    for (bad, needle) in [
+        (valid.replace("0.001", "-5"), "noise_relmse"),
+        (
+            valid.replace("\"seed\"", "\"notes\": \"x\", \"seed\""),
+            "notes",
+        ),
+    ] {
+        std::fs::write(dir.join("ref.json"), bad).unwrap();
+        let stderr = failure(&["compare", "wide.exr", "ref.exr"], &dir);
+        assert!(
+            stderr.contains("ref.json") && stderr.contains(needle),
+            "{stderr}"
+        );
+    }
+}

@@ -43,6 +43,23 @@ pub trait Estimator: Send {
 /// Names of the estimators this build knows, for `--help` and error messages.
 pub const ESTIMATOR_NAMES: &[&str] = &["pt", "eyelight"];
 
+/// Fails, listing the known names, unless `name` is one of `ESTIMATOR_NAMES`: for commands
+/// to check before they load a scene.
+pub fn check_name(name: &str) -> Result<()> {
+    if ESTIMATOR_NAMES.contains(&name) {
+        Ok(())
+    } else {
+        Err(unknown_estimator(name))
+    }
+}
+
+fn unknown_estimator(name: &str) -> Error {
+    Error::usage(format!(
+        "unknown estimator '{name}' (known: {})",
+        ESTIMATOR_NAMES.join(", ")
+    ))
+}
+
 /// Makes the estimator called `name`, reading its parameters from `params`.
 /// Fails on an unknown name or a parameter the estimator does not have.
 pub fn create(name: &str, params: &Params, scene: &Scene, seed: u64) -> Result<Box<dyn Estimator>> {
@@ -54,12 +71,7 @@ pub fn create(name: &str, params: &Params, scene: &Scene, seed: u64) -> Result<B
             pt::new(scene, seed, pt::PtSettings::from_params(params, scene)?)
                 .with_pixel_samples(pixel_samples(params, scene, seed)?),
         ),
-        _ => {
-            return Err(Error::usage(format!(
-                "unknown estimator '{name}' (known: {})",
-                ESTIMATOR_NAMES.join(", ")
-            )));
-        }
+        _ => return Err(unknown_estimator(name)),
     };
     params.check_all_used(name)?;
     Ok(estimator)

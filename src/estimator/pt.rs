@@ -48,6 +48,13 @@ impl PtSettings {
         let integrator = &scene.description.integrator;
         let max_depth: i64 = params.get("max_depth", integrator.max_depth as i64)?;
         let rr_depth: u32 = params.get("rr_depth", integrator.rr_depth)?;
+        // As the scene file's `rr_depth` (and Mitsuba 3): roulette at the camera vertex
+        // itself is not a setting either accepts.
+        if rr_depth == 0 {
+            return Err(crate::error::Error::usage(
+                "rr_depth must be greater than zero, got 0",
+            ));
+        }
         let max_depth = if max_depth < 0 {
             None
         } else {

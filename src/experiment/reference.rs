@@ -23,8 +23,10 @@ use crate::render::{Budget, render};
 use crate::sampler::independent::hash_words;
 use crate::scene::Scene;
 
-/// What is stored beside a reference EXR (`NAME.json`).
+/// What is stored beside a reference EXR (`NAME.json`). A key it does not know is refused
+/// when read: a misspelt `noise_relmse` would otherwise pass unnoticed.
 #[derive(Clone, Debug, Serialize, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
 pub struct ReferenceInfo {
     /// The cache key (hex) the reference was rendered for; empty for a file given by hand.
     pub key: String,
@@ -168,12 +170,24 @@ pub fn load(path: &Path) -> Result<Reference> {
     let json_path = path.with_extension("json");
     let info = if json_path.exists() {
         let text = std::fs::read_to_string(&json_path).map_err(|e| Error::io(&json_path, e))?;
-        serde_json::from_str(&text).map_err(|e| {
+        let info: ReferenceInfo = serde_json::from_str(&text).map_err(|e| {
             Error::input(
                 Location::file(&json_path),
                 format!("not a reference description: {e}"),
             )
-        })?
+        })?;
+        for (key, value) in [
+            ("noise_relmse", info.noise_relmse.unwrap_or(0.0)),
+            ("seconds", info.seconds),
+        ] {
+            if !(value.is_finite() && value >= 0.0) {
+                return Err(Error::input(
+                    Location::file(&json_path),
+                    format!("{key} must be finite and non-negative, got {value}"),
+                ));
+            }
+        }
+        info
     } else {
         ReferenceInfo {
             key: String::new(),
