@@ -296,3 +296,47 @@ fn bad_specs_and_corrupt_results_are_errors_naming_the_file() {
         .to_string();
     assert!(err.contains("--fresh"), "{err}");
 }
+
+/// Runs the mltbench binary in `dir`.
+fn mltbench_in(dir: &Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_mltbench"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn lecture_specs_say_they_run_whole() {
+    let dir = temp_dir("lecture-cli");
+    let spec = dir.join("spectra.toml");
+    std::fs::write(
+        &spec,
+        "kind = \"sampling-spectra\"\ndescription = \"x\"\npoints = 64\nrealisations = 1\n\
+         max_frequency = 4\n",
+    )
+    .unwrap();
+    let report = mltbench_in(&dir, &["report", "spectra.toml"]);
+    let err = String::from_utf8_lossy(&report.stderr);
+    assert!(!report.status.success());
+    assert!(
+        err.contains("spectra.toml") && err.contains("no separate report") && err.contains("run"),
+        "{err}"
+    );
+    assert!(!err.contains("unknown field"), "{err}");
+    let cell = mltbench_in(&dir, &["run", "spectra.toml", "--cell", "0"]);
+    let err = String::from_utf8_lossy(&cell.stderr);
+    assert!(
+        !cell.status.success() && err.contains("runs whole"),
+        "{err}"
+    );
+    // A kind that is not a string is a lecture spec with a bad kind, not an estimator race.
+    std::fs::write(&spec, "kind = 3\ndescription = \"x\"\n").unwrap();
+    let run = mltbench_in(&dir, &["run", "spectra.toml", "--results", "res"]);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        !run.status.success() && err.contains("spectra.toml:1: kind: kind must be a string"),
+        "{err}"
+    );
+}
+

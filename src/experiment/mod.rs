@@ -81,7 +81,7 @@ pub fn list_experiments() -> Result<Vec<(String, String)>> {
             .unwrap_or("")
             .to_string();
         let text = std::fs::read_to_string(&path).unwrap_or_default();
-        let description = if crate::lecture::kind_of(&text).is_some() {
+        let description = if crate::lecture::is_lecture(&text) {
             crate::lecture::description_of(&text).unwrap_or_default()
         } else {
             match Experiment::load(&path, false) {

@@ -182,11 +182,7 @@ impl Experiment {
         let fail = |message: String| Error::input(Location::file(path), message);
         // An error at the value `span` covers: the file, its line and the key.
         let fail_at = |span: std::ops::Range<usize>, key: &str, message: String| {
-            let line = 1 + text.as_bytes()[..span.start.min(text.len())]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count();
-            Error::input(Location::at(path, line as u32, key), message)
+            Error::input(Location::at(path, line_of(text, span.start), key), message)
         };
         let file: SpecFile = toml::from_str(text).map_err(|e| fail(e.to_string()))?;
         let dir = path.parent().unwrap_or(Path::new("."));
@@ -363,6 +359,15 @@ impl Experiment {
             }
         }
     }
+}
+
+/// The 1-based line of byte `offset` in `text` (clamped to its end).
+pub fn line_of(text: &str, offset: usize) -> u32 {
+    let newlines = text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count();
+    (1 + newlines).try_into().unwrap_or(u32::MAX)
 }
 
 fn parse_budget(b: &BudgetFile, what: &str, scale: f64) -> std::result::Result<Budget, String> {
