@@ -53,7 +53,8 @@ struct RunArgs {
     /// run; results go to results/NAME-quick/).
     #[arg(long)]
     quick: bool,
-    /// Delete earlier results of this experiment and start over.
+    /// Delete earlier results of this experiment and start over (with --cell K: only cell
+    /// K's own files).
     #[arg(long)]
     fresh: bool,
     /// List the experiment's independent (estimator, run) cells and exit.

@@ -340,3 +340,151 @@ fn lecture_specs_say_they_run_whole() {
     );
 }
 
+/// The names of the files under `dir` (recursively, relative to it), sorted.
+fn files_under(dir: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                out.push(path.strip_prefix(dir).unwrap().display().to_string());
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn fresh_with_one_cell_discards_only_that_cells_files() {
+    let dir = temp_dir("fresh-cell");
+    let spec = tiny_spec(&dir, "{ passes = 4 }");
+    let exp = Experiment::load(&spec, false).unwrap();
+    let results = dir.join("results");
+    experiment::run(&exp, &options(&results), &ProgressBar::hidden()).unwrap();
+    let out = results.join("tiny");
+    let before = files_under(&out);
+    let rows_before = rows_without_time(&results);
+    // A stale checkpoint of cell 0 (pt run 0) and one of cell 1 (pt run 1).
+    std::fs::write(out.join("checkpoints/pt/run0-cp99.exr"), b"stale").unwrap();
+    std::fs::write(out.join("checkpoints/pt/run1-cp99.exr"), b"other").unwrap();
+
+    // `--cells --fresh` only lists.
+    let cells = mltbench_in(
+        &dir,
+        &[
+            "run",
+            "tiny.toml",
+            "--cells",
+            "--fresh",
+            "--results",
+            "results",
+        ],
+    );
+    assert!(cells.status.success());
+    assert!(out.join("checkpoints/pt/run0-cp99.exr").exists());
+
+    let mut fresh = options(&results);
+    fresh.cell = Some(0);
+    fresh.fresh = true;
+    let cell_csv = out.join("cells/pt-run0.csv");
+    let other_csv = out.join("cells/pt-run1.csv");
+    let other_text = std::fs::read(&other_csv).unwrap();
+    std::fs::write(&cell_csv, "stale\n").unwrap();
+    experiment::run(&exp, &fresh, &ProgressBar::hidden()).unwrap();
+    // Cell 0 was redone from nothing; every other cell's files are untouched.
+    assert!(!out.join("checkpoints/pt/run0-cp99.exr").exists());
+    assert!(out.join("checkpoints/pt/run1-cp99.exr").exists());
+    assert_eq!(std::fs::read(&other_csv).unwrap(), other_text);
+    std::fs::remove_file(out.join("checkpoints/pt/run1-cp99.exr")).unwrap();
+    assert_eq!(files_under(&out), before);
+    let summary = experiment::report_only(&exp, &results, &ProgressBar::hidden()).unwrap();
+    assert!(summary.missing_cells.is_empty());
+    assert_eq!(rows_without_time(&results), rows_before);
+
+    // Results of a different experiment: --cell K --fresh refuses and deletes nothing.
+    let changed = dir.join("changed");
+    std::fs::create_dir_all(&changed).unwrap();
+    let text = std::fs::read_to_string(&spec).unwrap();
+    let changed_spec = changed.join("tiny.toml");
+    std::fs::write(&changed_spec, text.replace("seed = 3", "seed = 4")).unwrap();
+    let exp2 = Experiment::load(&changed_spec, false).unwrap();
+    let err = experiment::run(&exp2, &fresh, &ProgressBar::hidden())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("fingerprint.txt") && err.contains("--prepare --fresh"),
+        "{err}"
+    );
+    assert_eq!(files_under(&out), before);
+}
+
+/// `experiments/slurm/run-array.sh` with a stand-in `sbatch` that runs each job at once, in
+/// order (array tasks one after another): the Slurm path end to end, without a cluster.
+fn slurm_run(dir: &Path, extra: &[&str]) -> std::process::Output {
+    let fake = dir.join("fake-bin");
+    std::fs::create_dir_all(&fake).unwrap();
+    let sbatch = fake.join("sbatch");
+    std::fs::write(
+        &sbatch,
+        r#"#!/usr/bin/env bash
+# Runs the --wrap command now (once per --array index); prints a job id.
+wrap=""; array=""
+while (($#)); do
+    case "$1" in
+        --wrap) wrap="$2"; shift ;;
+        --array) array="$2"; shift ;;
+    esac
+    shift
+done
+if [[ -n "$array" ]]; then
+    for ((i = ${array%-*}; i <= ${array#*-}; i++)); do
+        SLURM_ARRAY_TASK_ID=$i bash -c "$wrap" >>jobs.log 2>&1 || exit 1
+    done
+else
+    bash -c "$wrap" >>jobs.log 2>&1 || exit 1
+fi
+echo 1
+"#,
+    )
+    .unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&sbatch, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/slurm/run-array.sh");
+    let path = format!("{}:{}", fake.display(), std::env::var("PATH").unwrap());
+    std::process::Command::new("bash")
+        .arg(script)
+        .arg(dir.join("tiny.toml"))
+        .args(extra)
+        .env("PATH", path)
+        .env("MLTBENCH", env!("CARGO_BIN_EXE_mltbench"))
+        .env("CPUS_PER_CELL", "1")
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn a_slurm_array_launched_with_fresh_keeps_all_its_cells() {
+    let dir = temp_dir("slurm");
+    tiny_spec(&dir, "{ passes = 4 }");
+    for extra in [&["--results", "res"][..], &["--fresh", "--results", "res"]] {
+        let out = slurm_run(&dir, extra);
+        let log = std::fs::read_to_string(dir.join("jobs.log")).unwrap_or_default();
+        assert!(
+            out.status.success(),
+            "{extra:?}: {}\n{log}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let summary = std::fs::read_to_string(dir.join("res/tiny/summary.json")).unwrap();
+        assert!(
+            summary.contains("\"missing_cells\": []"),
+            "{extra:?}: {summary}"
+        );
+        assert_eq!(files_under(&dir.join("res/tiny/cells")).len(), 4);
+        std::fs::remove_file(dir.join("res/tiny/summary.json")).unwrap();
+    }
+}

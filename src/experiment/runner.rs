@@ -313,7 +313,8 @@ pub fn check_fingerprint(results: &ResultsDir, fingerprint: &str) -> Result<()> 
         Ok(_) => Err(Error::input(
             Location::file(&path),
             "these results were made from a different experiment (spec, scene or version); \
-             rerun with --fresh to start over",
+             rerun with --fresh to start over (with --cell K, --fresh discards only that \
+             cell's files: start a cluster run over with `run NAME --prepare --fresh`)",
         )),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
             std::fs::create_dir_all(&results.dir).map_err(|e| Error::io(&results.dir, e))?;
@@ -334,6 +335,45 @@ pub fn clear_results(results: &ResultsDir) -> Result<()> {
     let f = results.dir.join("fingerprint.txt");
     if f.exists() {
         std::fs::remove_file(&f).map_err(|e| Error::io(&f, e))?;
+    }
+    Ok(())
+}
+
+/// Removes cell (estimator `e`, run `r`)'s own files: its rows, checkpoint images and final
+/// image (for `--cell K --fresh`; every other cell's files stay).
+pub fn clear_cell(experiment: &Experiment, results: &ResultsDir, e: usize, r: u32) -> Result<()> {
+    let label = &experiment.estimators[e].label;
+    let final_image = results.final_image(label, r);
+    let mut files = vec![
+        results.cell_csv(label, r),
+        final_image.with_extension("png"),
+        final_image,
+    ];
+    // Every checkpoint image of this run, also any beyond the current checkpoint count.
+    let checkpoints = results
+        .checkpoint_image(label, r, 0)
+        .parent()
+        .map(Path::to_path_buf);
+    if let Some(dir) = checkpoints.filter(|d| d.is_dir()) {
+        let prefix = format!("run{r}-cp");
+        for entry in std::fs::read_dir(&dir).map_err(|e| Error::io(&dir, e))? {
+            let path = entry.map_err(|e| Error::io(&dir, e))?.path();
+            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            let is_mine = name
+                .strip_prefix(&prefix)
+                .and_then(|rest| rest.strip_suffix(".exr"))
+                .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()));
+            if is_mine {
+                files.push(path);
+            }
+        }
+    }
+    for f in files {
+        match std::fs::remove_file(&f) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(Error::io(&f, e)),
+        }
     }
     Ok(())
 }
