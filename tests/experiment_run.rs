@@ -235,6 +235,21 @@ fn bad_specs_and_corrupt_results_are_errors_naming_the_file() {
             good.replace("checkpoints = 6", "checkpoints = = 6"),
             "checkpoints = = 6",
         ),
+        (
+            "dot-dot label",
+            good.replace("label = \"preview (biased)\"", "label = \"..\""),
+            "label = \"..\"",
+        ),
+        (
+            "dot label",
+            good.replace("label = \"preview (biased)\"", "label = \".\""),
+            "label = \".\"",
+        ),
+        (
+            "hidden label",
+            good.replace("label = \"preview (biased)\"", "label = \".preview\""),
+            "label = \".preview\"",
+        ),
     ];
     for (what, text, on_line) in cases {
         let path = dir.join(format!("{}.toml", what.replace(' ', "_")));
@@ -270,6 +285,32 @@ fn bad_specs_and_corrupt_results_are_errors_naming_the_file() {
         err.contains("bad_param.toml") && err.contains("rr_dpeth"),
         "{err}"
     );
+    assert!(
+        !dir.join("none/references").exists(),
+        "nothing was rendered"
+    );
+
+    // A region outside the film: refused naming the spec, the region's line and its label,
+    // before the reference renders.
+    let path = dir.join("bad_region.toml");
+    let text = good.replace("x = 12", "x = 100");
+    std::fs::write(&path, &text).unwrap();
+    let exp = Experiment::load(&path, false).unwrap();
+    let line = 1 + text[..text.find("[[region]]").unwrap()]
+        .matches('\n')
+        .count();
+    for outcome in [
+        experiment::run(&exp, &options(&dir.join("none")), &ProgressBar::hidden()).map(|_| ()),
+        experiment::prepare(&exp, &options(&dir.join("none")), &ProgressBar::hidden()),
+    ] {
+        let err = outcome.unwrap_err().to_string();
+        assert!(
+            err.contains(&format!("bad_region.toml:{line}:"))
+                && err.contains("\"light\"")
+                && err.contains("32×32"),
+            "{err}"
+        );
+    }
     assert!(
         !dir.join("none/references").exists(),
         "nothing was rendered"

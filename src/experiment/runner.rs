@@ -173,14 +173,15 @@ impl ResultsDir {
     }
 }
 
-/// Loads the experiment's scene with its parameters, and checks that every estimator (and
-/// the reference's) accepts its parameters, so that a misspelt one fails before any
-/// rendering rather than after the reference.
+/// Loads the experiment's scene with its parameters, and checks that every region lies on
+/// its film and every estimator (and the reference's) accepts its parameters, so that a
+/// mistake fails before any rendering rather than after the reference.
 pub fn load_scene(experiment: &Experiment) -> Result<Scene> {
     let scene = Scene::build(mitsuba::load_file_with(
         &experiment.scene,
         &experiment.scene_params,
     )?)?;
+    experiment.check_regions(scene.width(), scene.height())?;
     let mut entries: Vec<(&str, &[String])> = experiment
         .estimators
         .iter()
