@@ -322,11 +322,47 @@ fn bad_specs_and_corrupt_results_are_errors_naming_the_file() {
     let results = dir.join("results");
     experiment::run(&exp, &options(&results), &ProgressBar::hidden()).unwrap();
     let cell = results.join("tiny/cells/pt-run1.csv");
+    let intact = std::fs::read_to_string(&cell).unwrap();
     std::fs::write(&cell, "garbage,\u{0}\n1,2,3\n").unwrap();
     let err = experiment::report_only(&exp, &results, &ProgressBar::hidden())
         .unwrap_err()
         .to_string();
     assert!(err.contains("pt-run1.csv"), "{err}");
+    // Rows that parse but cannot be results: refused naming the file and the row's line
+    // (line 3 is the second row: checkpoint 0 of the region).
+    let second: Vec<&str> = intact.lines().nth(2).unwrap().split(',').collect();
+    let with = |i: usize, value: &str| {
+        let mut f = second.clone();
+        f[i] = value;
+        f.join(",")
+    };
+    let duplicate = intact.lines().nth(1).unwrap().to_string();
+    for (bad, what) in [
+        (with(7, "nan"), "relmse"),
+        (with(8, "-1e-3"), "rmse"),
+        (with(9, "inf"), "mape"),
+        (with(3, "-0.5"), "seconds"),
+        (with(1, "4294967297"), "run must be"),
+        (with(2, "99999999999"), "checkpoint must be"),
+        (with(1, "0"), "names pt run 0"),
+        (with(0, "eyelight"), "names eyelight"),
+        (with(2, "6"), "out of range"),
+        (with(6, "nowhere"), "region \"nowhere\""),
+        (duplicate, "appears twice"),
+    ] {
+        let mut lines: Vec<&str> = intact.lines().collect();
+        lines[2] = &bad;
+        std::fs::write(&cell, lines.join("\n") + "\n").unwrap();
+        let err = experiment::report_only(&exp, &results, &ProgressBar::hidden())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("pt-run1.csv:3:") && err.contains(what),
+            "{bad}: {err}"
+        );
+    }
+    std::fs::write(&cell, &intact).unwrap();
+    experiment::report_only(&exp, &results, &ProgressBar::hidden()).unwrap();
 
     // A changed experiment does not mix with earlier results.
     let changed = spec.with_file_name("tiny.toml");

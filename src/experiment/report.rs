@@ -12,7 +12,7 @@ use super::plot::{
     Band, Crop, Series, SheetEntry, bias_variance_plot, contact_sheet, convergence_plot,
 };
 use super::reference::Reference;
-use super::runner::{ResultsDir, Row, cell_is_complete, read_rows, write_rows};
+use super::runner::{ResultsDir, Row, cell_is_complete, read_cell_rows, write_rows};
 use super::spec::Experiment;
 use super::statistics::{
     BiasVariance, Interval, SlopeFit, bias_variance, fit_later_half, mean_interval,
@@ -81,7 +81,7 @@ pub fn report(
     for (e, r) in experiment.cells() {
         let label = &experiment.estimators[e].label;
         if cell_is_complete(experiment, results, e, r)? {
-            rows.extend(read_rows(&results.cell_csv(label, r))?);
+            rows.extend(read_cell_rows(experiment, results, e, r)?);
         } else {
             missing.push(format!("{label} run {r}"));
         }
