@@ -121,6 +121,19 @@ fn a_tiny_experiment_runs_end_to_end_and_its_plots_decode() {
     assert_eq!(read_rows_count(&out.join("metrics.csv")), 24);
     let pt = &summary.estimators[0];
     let preview = &summary.estimators[1];
+    // Two runs: t = 12.7, yet no interval of a positive quantity goes below 0.
+    for e in &summary.estimators {
+        for i in [e.relmse, e.rmse, e.mape, e.efficiency] {
+            assert!(
+                i.lo >= 0.0 && i.lo <= i.mean && i.mean <= i.hi,
+                "{}: {i:?}",
+                e.label
+            );
+        }
+        for (_, i) in &e.regions {
+            assert!(i.lo >= 0.0, "{}: {i:?}", e.label);
+        }
+    }
     // The preview is biased: far larger error, and its error does not fall with time.
     assert!(preview.relmse.mean > 10.0 * pt.relmse.mean);
     assert!(pt.slope_passes.unwrap().slope < -0.5);
