@@ -31,7 +31,8 @@ enum Command {
     Render(RenderArgs),
     /// Run a named experiment (experiments/NAME.toml, or a path to a .toml file): every
     /// estimator × run to its checkpoints, against the reference, then the report under
-    /// results/NAME/. Resumes where an earlier run stopped unless --fresh.
+    /// results/NAME/. Unless --fresh, cells an earlier run finished are kept and an
+    /// unfinished cell starts again from its first pass.
     Run(RunArgs),
     /// List the experiments with one-line descriptions.
     List,

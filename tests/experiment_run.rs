@@ -171,6 +171,28 @@ fn an_interrupted_run_resumes_to_the_same_rows() {
 
     experiment::run(&exp, &options(&interrupted), &ProgressBar::hidden()).unwrap();
     assert_eq!(rows_without_time(&whole), rows_without_time(&interrupted));
+
+    // Interrupted in the second cell: the finished first cell is kept as it is (not
+    // rendered again), the second starts over and comes out the same.
+    let later = dir.join("later");
+    let mut stop = options(&later);
+    stop.stop_after_checkpoints = Some(exp.checkpoint_budgets().len() + 1);
+    experiment::run(&exp, &stop, &ProgressBar::hidden()).unwrap_err();
+    let first = [
+        later.join("tiny/cells/pt-run0.csv"),
+        later.join("tiny/images/pt-run0.exr"),
+    ];
+    let stamps = |files: &[PathBuf]| -> Vec<std::time::SystemTime> {
+        files
+            .iter()
+            .map(|f| std::fs::metadata(f).unwrap().modified().unwrap())
+            .collect()
+    };
+    let before = stamps(&first);
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    experiment::run(&exp, &options(&later), &ProgressBar::hidden()).unwrap();
+    assert_eq!(stamps(&first), before);
+    assert_eq!(rows_without_time(&whole), rows_without_time(&later));
 }
 
 #[test]
