@@ -31,7 +31,8 @@ enum Command {
     Render(RenderArgs),
     /// Run a named experiment (experiments/NAME.toml, or a path to a .toml file): every
     /// estimator × run to its checkpoints, against the reference, then the report under
-    /// results/NAME/. Resumes where an earlier run stopped unless --fresh.
+    /// results/NAME/. Unless --fresh, cells an earlier run finished are kept and an
+    /// unfinished cell starts again from its first pass.
     Run(RunArgs),
     /// List the experiments with one-line descriptions.
     List,
@@ -53,7 +54,8 @@ struct RunArgs {
     /// run; results go to results/NAME-quick/).
     #[arg(long)]
     quick: bool,
-    /// Delete earlier results of this experiment and start over.
+    /// Delete earlier results of this experiment and start over (with --cell K: only cell
+    /// K's own files).
     #[arg(long)]
     fresh: bool,
     /// List the experiment's independent (estimator, run) cells and exit.
@@ -282,15 +284,16 @@ fn experiment_bar() -> ProgressBar {
 fn run_experiment(args: RunArgs) -> Result<()> {
     let path = experiment::find_experiment(&args.experiment)?;
     let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
-    if let Some(kind) = mltbench::lecture::kind_of(&text) {
+    if mltbench::lecture::is_lecture(&text) {
         if args.cells || args.cell.is_some() || args.prepare || args.quick {
             return Err(Error::usage(format!(
-                "{}: a \"{kind}\" experiment runs whole (no --quick, --cells, --cell, --prepare)",
+                "{}: a lecture experiment (with `kind`) runs whole: no --quick, --cells, \
+                 --cell or --prepare",
                 path.display()
             )));
         }
         let pool = thread_pool(args.threads)?;
-        let out = pool.install(|| mltbench::lecture::run(&kind, &path, &text, &args.results))?;
+        let (kind, out) = pool.install(|| mltbench::lecture::run(&path, &text, &args.results))?;
         eprintln!("{kind}: results in {}", out.display());
         return Ok(());
     }
@@ -364,6 +367,15 @@ fn list_experiments() -> Result<()> {
 
 fn report_experiment(args: ReportArgs) -> Result<()> {
     let path = experiment::find_experiment(&args.experiment)?;
+    let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+    if mltbench::lecture::is_lecture(&text) {
+        return Err(Error::usage(format!(
+            "{}: a lecture experiment (with `kind`) has no separate report: \
+             `mltbench run {}` runs it whole and writes its summary, plots and README",
+            path.display(),
+            args.experiment
+        )));
+    }
     let exp = Experiment::load(&path, args.quick)?;
     let bar = experiment_bar();
     let summary = experiment::report_only(&exp, &args.results, &bar);

@@ -8,6 +8,7 @@ use mltbench::experiment::metrics::{
 };
 use mltbench::experiment::statistics::{
     bias_variance, fit_later_half, fit_power_law, later_half, mean_interval,
+    nonnegative_mean_interval,
 };
 use mltbench::image::Image;
 use mltbench::math::Rgb;
@@ -256,6 +257,23 @@ fn mean_interval_uses_student_t_quantiles() {
     }
     let none = mean_interval(&[], 0.95);
     assert!(none.mean.is_nan() && none.lo.is_nan() && none.hi.is_nan());
+}
+
+#[test]
+fn intervals_of_nonnegative_quantities_stay_at_or_above_zero() {
+    // Two runs' relMSE: the t interval reaches below 0; the upper end and mean are kept.
+    let values = [1e-3, 1e-2];
+    let t = mean_interval(&values, 0.95);
+    assert!(t.lo < 0.0, "{t:?}");
+    let i = nonnegative_mean_interval(&values, 0.95);
+    assert_eq!((i.mean, i.lo, i.hi), (t.mean, 0.0, t.hi));
+    // Already positive: unchanged; no values: still NaN.
+    let values = [1.0, 1.1, 0.9, 1.05];
+    assert_eq!(
+        nonnegative_mean_interval(&values, 0.95),
+        mean_interval(&values, 0.95)
+    );
+    assert!(nonnegative_mean_interval(&[], 0.95).lo.is_nan());
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -121,6 +121,19 @@ fn a_tiny_experiment_runs_end_to_end_and_its_plots_decode() {
     assert_eq!(read_rows_count(&out.join("metrics.csv")), 24);
     let pt = &summary.estimators[0];
     let preview = &summary.estimators[1];
+    // Two runs: t = 12.7, yet no interval of a positive quantity goes below 0.
+    for e in &summary.estimators {
+        for i in [e.relmse, e.rmse, e.mape, e.efficiency] {
+            assert!(
+                i.lo >= 0.0 && i.lo <= i.mean && i.mean <= i.hi,
+                "{}: {i:?}",
+                e.label
+            );
+        }
+        for (_, i) in &e.regions {
+            assert!(i.lo >= 0.0, "{}: {i:?}", e.label);
+        }
+    }
     // The preview is biased: far larger error, and its error does not fall with time.
     assert!(preview.relmse.mean > 10.0 * pt.relmse.mean);
     assert!(pt.slope_passes.unwrap().slope < -0.5);
@@ -158,6 +171,28 @@ fn an_interrupted_run_resumes_to_the_same_rows() {
 
     experiment::run(&exp, &options(&interrupted), &ProgressBar::hidden()).unwrap();
     assert_eq!(rows_without_time(&whole), rows_without_time(&interrupted));
+
+    // Interrupted in the second cell: the finished first cell is kept as it is (not
+    // rendered again), the second starts over and comes out the same.
+    let later = dir.join("later");
+    let mut stop = options(&later);
+    stop.stop_after_checkpoints = Some(exp.checkpoint_budgets().len() + 1);
+    experiment::run(&exp, &stop, &ProgressBar::hidden()).unwrap_err();
+    let first = [
+        later.join("tiny/cells/pt-run0.csv"),
+        later.join("tiny/images/pt-run0.exr"),
+    ];
+    let stamps = |files: &[PathBuf]| -> Vec<std::time::SystemTime> {
+        files
+            .iter()
+            .map(|f| std::fs::metadata(f).unwrap().modified().unwrap())
+            .collect()
+    };
+    let before = stamps(&first);
+    std::thread::sleep(std::time::Duration::from_millis(20));
+    experiment::run(&exp, &options(&later), &ProgressBar::hidden()).unwrap();
+    assert_eq!(stamps(&first), before);
+    assert_eq!(rows_without_time(&whole), rows_without_time(&later));
 }
 
 #[test]
@@ -235,6 +270,21 @@ fn bad_specs_and_corrupt_results_are_errors_naming_the_file() {
             good.replace("checkpoints = 6", "checkpoints = = 6"),
             "checkpoints = = 6",
         ),
+        (
+            "dot-dot label",
+            good.replace("label = \"preview (biased)\"", "label = \"..\""),
+            "label = \"..\"",
+        ),
+        (
+            "dot label",
+            good.replace("label = \"preview (biased)\"", "label = \".\""),
+            "label = \".\"",
+        ),
+        (
+            "hidden label",
+            good.replace("label = \"preview (biased)\"", "label = \".preview\""),
+            "label = \".preview\"",
+        ),
     ];
     for (what, text, on_line) in cases {
         let path = dir.join(format!("{}.toml", what.replace(' ', "_")));
@@ -275,17 +325,79 @@ fn bad_specs_and_corrupt_results_are_errors_naming_the_file() {
         "nothing was rendered"
     );
 
+    // A region outside the film: refused naming the spec, the region's line and its label,
+    // before the reference renders.
+    let path = dir.join("bad_region.toml");
+    let text = good.replace("x = 12", "x = 100");
+    std::fs::write(&path, &text).unwrap();
+    let exp = Experiment::load(&path, false).unwrap();
+    let line = 1 + text[..text.find("[[region]]").unwrap()]
+        .matches('\n')
+        .count();
+    for outcome in [
+        experiment::run(&exp, &options(&dir.join("none")), &ProgressBar::hidden()).map(|_| ()),
+        experiment::prepare(&exp, &options(&dir.join("none")), &ProgressBar::hidden()),
+    ] {
+        let err = outcome.unwrap_err().to_string();
+        assert!(
+            err.contains(&format!("bad_region.toml:{line}:"))
+                && err.contains("\"light\"")
+                && err.contains("32×32"),
+            "{err}"
+        );
+    }
+    assert!(
+        !dir.join("none/references").exists(),
+        "nothing was rendered"
+    );
+
     // A corrupt cell file in the results: an error naming it, not a panic.
     let spec = tiny_spec(&dir, "{ passes = 4 }");
     let exp = Experiment::load(&spec, false).unwrap();
     let results = dir.join("results");
     experiment::run(&exp, &options(&results), &ProgressBar::hidden()).unwrap();
     let cell = results.join("tiny/cells/pt-run1.csv");
+    let intact = std::fs::read_to_string(&cell).unwrap();
     std::fs::write(&cell, "garbage,\u{0}\n1,2,3\n").unwrap();
     let err = experiment::report_only(&exp, &results, &ProgressBar::hidden())
         .unwrap_err()
         .to_string();
     assert!(err.contains("pt-run1.csv"), "{err}");
+    // Rows that parse but cannot be results: refused naming the file and the row's line
+    // (line 3 is the second row: checkpoint 0 of the region).
+    let second: Vec<&str> = intact.lines().nth(2).unwrap().split(',').collect();
+    let with = |i: usize, value: &str| {
+        let mut f = second.clone();
+        f[i] = value;
+        f.join(",")
+    };
+    let duplicate = intact.lines().nth(1).unwrap().to_string();
+    for (bad, what) in [
+        (with(7, "nan"), "relmse"),
+        (with(8, "-1e-3"), "rmse"),
+        (with(9, "inf"), "mape"),
+        (with(3, "-0.5"), "seconds"),
+        (with(1, "4294967297"), "run must be"),
+        (with(2, "99999999999"), "checkpoint must be"),
+        (with(1, "0"), "names pt run 0"),
+        (with(0, "eyelight"), "names eyelight"),
+        (with(2, "6"), "out of range"),
+        (with(6, "nowhere"), "region \"nowhere\""),
+        (duplicate, "appears twice"),
+    ] {
+        let mut lines: Vec<&str> = intact.lines().collect();
+        lines[2] = &bad;
+        std::fs::write(&cell, lines.join("\n") + "\n").unwrap();
+        let err = experiment::report_only(&exp, &results, &ProgressBar::hidden())
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("pt-run1.csv:3:") && err.contains(what),
+            "{bad}: {err}"
+        );
+    }
+    std::fs::write(&cell, &intact).unwrap();
+    experiment::report_only(&exp, &results, &ProgressBar::hidden()).unwrap();
 
     // A changed experiment does not mix with earlier results.
     let changed = spec.with_file_name("tiny.toml");
@@ -295,4 +407,196 @@ fn bad_specs_and_corrupt_results_are_errors_naming_the_file() {
         .unwrap_err()
         .to_string();
     assert!(err.contains("--fresh"), "{err}");
+}
+
+/// Runs the mltbench binary in `dir`.
+fn mltbench_in(dir: &Path, args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_mltbench"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn lecture_specs_say_they_run_whole() {
+    let dir = temp_dir("lecture-cli");
+    let spec = dir.join("spectra.toml");
+    std::fs::write(
+        &spec,
+        "kind = \"sampling-spectra\"\ndescription = \"x\"\npoints = 64\nrealisations = 1\n\
+         max_frequency = 4\n",
+    )
+    .unwrap();
+    let report = mltbench_in(&dir, &["report", "spectra.toml"]);
+    let err = String::from_utf8_lossy(&report.stderr);
+    assert!(!report.status.success());
+    assert!(
+        err.contains("spectra.toml") && err.contains("no separate report") && err.contains("run"),
+        "{err}"
+    );
+    assert!(!err.contains("unknown field"), "{err}");
+    let cell = mltbench_in(&dir, &["run", "spectra.toml", "--cell", "0"]);
+    let err = String::from_utf8_lossy(&cell.stderr);
+    assert!(
+        !cell.status.success() && err.contains("runs whole"),
+        "{err}"
+    );
+    // A kind that is not a string is a lecture spec with a bad kind, not an estimator race.
+    std::fs::write(&spec, "kind = 3\ndescription = \"x\"\n").unwrap();
+    let run = mltbench_in(&dir, &["run", "spectra.toml", "--results", "res"]);
+    let err = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        !run.status.success() && err.contains("spectra.toml:1: kind: kind must be a string"),
+        "{err}"
+    );
+}
+
+/// The names of the files under `dir` (recursively, relative to it), sorted.
+fn files_under(dir: &Path) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut stack = vec![dir.to_path_buf()];
+    while let Some(d) = stack.pop() {
+        for entry in std::fs::read_dir(&d).unwrap() {
+            let path = entry.unwrap().path();
+            if path.is_dir() {
+                stack.push(path);
+            } else {
+                out.push(path.strip_prefix(dir).unwrap().display().to_string());
+            }
+        }
+    }
+    out.sort();
+    out
+}
+
+#[test]
+fn fresh_with_one_cell_discards_only_that_cells_files() {
+    let dir = temp_dir("fresh-cell");
+    let spec = tiny_spec(&dir, "{ passes = 4 }");
+    let exp = Experiment::load(&spec, false).unwrap();
+    let results = dir.join("results");
+    experiment::run(&exp, &options(&results), &ProgressBar::hidden()).unwrap();
+    let out = results.join("tiny");
+    let before = files_under(&out);
+    let rows_before = rows_without_time(&results);
+    // A stale checkpoint of cell 0 (pt run 0) and one of cell 1 (pt run 1).
+    std::fs::write(out.join("checkpoints/pt/run0-cp99.exr"), b"stale").unwrap();
+    std::fs::write(out.join("checkpoints/pt/run1-cp99.exr"), b"other").unwrap();
+
+    // `--cells --fresh` only lists.
+    let cells = mltbench_in(
+        &dir,
+        &[
+            "run",
+            "tiny.toml",
+            "--cells",
+            "--fresh",
+            "--results",
+            "results",
+        ],
+    );
+    assert!(cells.status.success());
+    assert!(out.join("checkpoints/pt/run0-cp99.exr").exists());
+
+    let mut fresh = options(&results);
+    fresh.cell = Some(0);
+    fresh.fresh = true;
+    let cell_csv = out.join("cells/pt-run0.csv");
+    let other_csv = out.join("cells/pt-run1.csv");
+    let other_text = std::fs::read(&other_csv).unwrap();
+    std::fs::write(&cell_csv, "stale\n").unwrap();
+    experiment::run(&exp, &fresh, &ProgressBar::hidden()).unwrap();
+    // Cell 0 was redone from nothing; every other cell's files are untouched.
+    assert!(!out.join("checkpoints/pt/run0-cp99.exr").exists());
+    assert!(out.join("checkpoints/pt/run1-cp99.exr").exists());
+    assert_eq!(std::fs::read(&other_csv).unwrap(), other_text);
+    std::fs::remove_file(out.join("checkpoints/pt/run1-cp99.exr")).unwrap();
+    assert_eq!(files_under(&out), before);
+    let summary = experiment::report_only(&exp, &results, &ProgressBar::hidden()).unwrap();
+    assert!(summary.missing_cells.is_empty());
+    assert_eq!(rows_without_time(&results), rows_before);
+
+    // Results of a different experiment: --cell K --fresh refuses and deletes nothing.
+    let changed = dir.join("changed");
+    std::fs::create_dir_all(&changed).unwrap();
+    let text = std::fs::read_to_string(&spec).unwrap();
+    let changed_spec = changed.join("tiny.toml");
+    std::fs::write(&changed_spec, text.replace("seed = 3", "seed = 4")).unwrap();
+    let exp2 = Experiment::load(&changed_spec, false).unwrap();
+    let err = experiment::run(&exp2, &fresh, &ProgressBar::hidden())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("fingerprint.txt") && err.contains("--prepare --fresh"),
+        "{err}"
+    );
+    assert_eq!(files_under(&out), before);
+}
+
+/// `experiments/slurm/run-array.sh` with a stand-in `sbatch` that runs each job at once, in
+/// order (array tasks one after another): the Slurm path end to end, without a cluster.
+fn slurm_run(dir: &Path, extra: &[&str]) -> std::process::Output {
+    let fake = dir.join("fake-bin");
+    std::fs::create_dir_all(&fake).unwrap();
+    let sbatch = fake.join("sbatch");
+    std::fs::write(
+        &sbatch,
+        r#"#!/usr/bin/env bash
+# Runs the --wrap command now (once per --array index); prints a job id.
+wrap=""; array=""
+while (($#)); do
+    case "$1" in
+        --wrap) wrap="$2"; shift ;;
+        --array) array="$2"; shift ;;
+    esac
+    shift
+done
+if [[ -n "$array" ]]; then
+    for ((i = ${array%-*}; i <= ${array#*-}; i++)); do
+        SLURM_ARRAY_TASK_ID=$i bash -c "$wrap" >>jobs.log 2>&1 || exit 1
+    done
+else
+    bash -c "$wrap" >>jobs.log 2>&1 || exit 1
+fi
+echo 1
+"#,
+    )
+    .unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&sbatch, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/slurm/run-array.sh");
+    let path = format!("{}:{}", fake.display(), std::env::var("PATH").unwrap());
+    std::process::Command::new("bash")
+        .arg(script)
+        .arg(dir.join("tiny.toml"))
+        .args(extra)
+        .env("PATH", path)
+        .env("MLTBENCH", env!("CARGO_BIN_EXE_mltbench"))
+        .env("CPUS_PER_CELL", "1")
+        .current_dir(dir)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn a_slurm_array_launched_with_fresh_keeps_all_its_cells() {
+    let dir = temp_dir("slurm");
+    tiny_spec(&dir, "{ passes = 4 }");
+    for extra in [&["--results", "res"][..], &["--fresh", "--results", "res"]] {
+        let out = slurm_run(&dir, extra);
+        let log = std::fs::read_to_string(dir.join("jobs.log")).unwrap_or_default();
+        assert!(
+            out.status.success(),
+            "{extra:?}: {}\n{log}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let summary = std::fs::read_to_string(dir.join("res/tiny/summary.json")).unwrap();
+        assert!(
+            summary.contains("\"missing_cells\": []"),
+            "{extra:?}: {summary}"
+        );
+        assert_eq!(files_under(&dir.join("res/tiny/cells")).len(), 4);
+        std::fs::remove_file(dir.join("res/tiny/summary.json")).unwrap();
+    }
 }

@@ -81,7 +81,7 @@ pub fn list_experiments() -> Result<Vec<(String, String)>> {
             .unwrap_or("")
             .to_string();
         let text = std::fs::read_to_string(&path).unwrap_or_default();
-        let description = if crate::lecture::kind_of(&text).is_some() {
+        let description = if crate::lecture::is_lecture(&text) {
             crate::lecture::description_of(&text).unwrap_or_default()
         } else {
             match Experiment::load(&path, false) {
@@ -100,7 +100,8 @@ pub fn list_experiments() -> Result<Vec<(String, String)>> {
 pub struct RunOptions {
     /// The `results/` folder.
     pub results_root: PathBuf,
-    /// Delete earlier results of this experiment first instead of resuming.
+    /// Delete earlier results first instead of resuming: the whole experiment's, or with
+    /// `cell` only that cell's own files.
     pub fresh: bool,
     /// Run only this cell (`Experiment::cells` index) and write only its files.
     pub cell: Option<usize>,
@@ -129,12 +130,21 @@ pub fn run(
         })?],
         None => cells.clone(),
     };
-    if options.fresh {
-        runner::clear_results(&results)?;
-    }
     bar.set_message(format!("{}: loading the scene", experiment.name));
     let scene = runner::load_scene(experiment)?;
-    runner::check_fingerprint(&results, &runner::fingerprint(experiment, &scene)?)?;
+    let fingerprint = runner::fingerprint(experiment, &scene)?;
+    // --fresh on the whole experiment clears it all; with --cell K only cell K's own
+    // files go (a Slurm array run with --fresh must not wipe the cells of its other tasks),
+    // and then only if the other cells' results were made from this same experiment.
+    if options.fresh && options.cell.is_none() {
+        runner::clear_results(&results)?;
+    }
+    runner::check_fingerprint(&results, &fingerprint)?;
+    if options.fresh && options.cell.is_some() {
+        for &(e, r) in &selected {
+            runner::clear_cell(experiment, &results, e, r)?;
+        }
+    }
     let reference = runner::obtain_reference(experiment, &scene, &options.results_root, bar)?;
 
     let todo: Vec<(usize, u32)> = selected
@@ -202,10 +212,11 @@ pub fn report_only(
 /// spreading cells over several machines, so that they do not each render it.
 pub fn prepare(experiment: &Experiment, options: &RunOptions, bar: &ProgressBar) -> Result<()> {
     let results = ResultsDir::new(&options.results_root, experiment);
+    let scene = runner::load_scene(experiment)?;
+    let fingerprint = runner::fingerprint(experiment, &scene)?;
     if options.fresh {
         runner::clear_results(&results)?;
     }
-    let scene = runner::load_scene(experiment)?;
-    runner::check_fingerprint(&results, &runner::fingerprint(experiment, &scene)?)?;
+    runner::check_fingerprint(&results, &fingerprint)?;
     runner::obtain_reference(experiment, &scene, &options.results_root, bar).map(|_| ())
 }

@@ -12,10 +12,10 @@ use super::plot::{
     Band, Crop, Series, SheetEntry, bias_variance_plot, contact_sheet, convergence_plot,
 };
 use super::reference::Reference;
-use super::runner::{ResultsDir, Row, cell_is_complete, read_rows, write_rows};
+use super::runner::{ResultsDir, Row, cell_is_complete, read_cell_rows, write_rows};
 use super::spec::Experiment;
 use super::statistics::{
-    BiasVariance, Interval, SlopeFit, bias_variance, fit_later_half, mean_interval,
+    BiasVariance, Interval, SlopeFit, bias_variance, fit_later_half, nonnegative_mean_interval,
 };
 use crate::error::{Error, Result};
 use crate::image::Image;
@@ -81,7 +81,7 @@ pub fn report(
     for (e, r) in experiment.cells() {
         let label = &experiment.estimators[e].label;
         if cell_is_complete(experiment, results, e, r)? {
-            rows.extend(read_rows(&results.cell_csv(label, r))?);
+            rows.extend(read_cell_rows(experiment, results, e, r)?);
         } else {
             missing.push(format!("{label} run {r}"));
         }
@@ -134,7 +134,7 @@ pub fn report(
             |k: u32| -> Vec<&Row> { mine.iter().copied().filter(|r| r.checkpoint == k).collect() };
         let finals = at(last);
         let values = |f: fn(&Row) -> f64| -> Vec<f64> { finals.iter().map(|r| f(r)).collect() };
-        let relmse = mean_interval(&values(|r| r.relmse), CONFIDENCE);
+        let relmse = nonnegative_mean_interval(&values(|r| r.relmse), CONFIDENCE);
 
         // Convergence curves: run mean and run range at each checkpoint.
         let mut band_s = Band {
@@ -226,7 +226,10 @@ pub fn report(
                     })
                     .map(|r| r.relmse)
                     .collect();
-                (region.label.clone(), mean_interval(&v, CONFIDENCE))
+                (
+                    region.label.clone(),
+                    nonnegative_mean_interval(&v, CONFIDENCE),
+                )
             })
             .collect();
         summaries.push(EstimatorSummary {
@@ -236,9 +239,12 @@ pub fn report(
             runs: finals.len(),
             seconds: values(|r| r.seconds).iter().sum::<f64>() / finals.len() as f64,
             passes: values(|r| r.passes as f64).iter().sum::<f64>() / finals.len() as f64,
-            rmse: mean_interval(&values(|r| r.rmse), CONFIDENCE),
-            mape: mean_interval(&values(|r| r.mape), CONFIDENCE),
-            efficiency: mean_interval(&values(|r| 1.0 / (r.relmse * r.seconds)), CONFIDENCE),
+            rmse: nonnegative_mean_interval(&values(|r| r.rmse), CONFIDENCE),
+            mape: nonnegative_mean_interval(&values(|r| r.mape), CONFIDENCE),
+            efficiency: nonnegative_mean_interval(
+                &values(|r| 1.0 / (r.relmse * r.seconds)),
+                CONFIDENCE,
+            ),
             below_reference_noise: noise.is_some_and(|n| relmse.mean < n),
             relmse,
             slope_seconds,
@@ -517,7 +523,10 @@ fn readme(experiment: &Experiment, s: &Summary, reference: &Reference) -> String
     }
     let _ = writeln!(
         md,
-        "\nSlope: least squares of log relMSE (mean over runs) against log time over the later half of \
+        "\nIntervals: 95% Student t over the runs; relMSE, RMSE, MAPE, efficiency and variance \
+         cannot be negative, so a lower end below 0 (few runs) is shown as 0, which keeps the \
+         t interval's coverage. \
+         Slope: least squares of log relMSE (mean over runs) against log time over the later half of \
          the checkpoints (−1 for an unbiased estimator). Efficiency = 1 / (relMSE × seconds). \
          Relative bias² and variance: DESIGN.md §5 across runs, each pixel term divided by \
          (y² + 0.01) as relMSE is; the t-test asks whether the mean signed error is 0. The \

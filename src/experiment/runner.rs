@@ -71,13 +71,14 @@ impl Row {
         )
     }
 
-    /// Parses one line of a cell or metrics file; errors name `path` and the line.
+    /// Parses one line of a cell or metrics file; errors name `path` and the line. Counts
+    /// must fit their types and times and metrics must be finite and non-negative.
     pub fn from_csv(line: &str, path: &Path, line_no: usize) -> Result<Row> {
-        let fail = |what: &str| {
+        let fail = |what: String| {
             Error::input(
                 Location {
                     file: path.to_path_buf(),
-                    line: Some(line_no as u32),
+                    line: Some(line_no.try_into().unwrap_or(u32::MAX)),
                     element: None,
                 },
                 format!("not an mltbench results row ({what}): \"{line}\""),
@@ -85,23 +86,43 @@ impl Row {
         };
         let f: Vec<&str> = line.split(',').collect();
         if f.len() != 10 {
-            return Err(fail("expected 10 fields"));
+            return Err(fail("expected 10 fields".into()));
         }
-        let num = |i: usize| {
-            f[i].parse::<f64>()
-                .map_err(|_| fail("a field is not a number"))
+        const NAMES: [&str; 10] = [
+            "estimator",
+            "run",
+            "checkpoint",
+            "seconds",
+            "passes",
+            "samples",
+            "region",
+            "relmse",
+            "rmse",
+            "mape",
+        ];
+        let num = |i: usize| match f[i].parse::<f64>() {
+            Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+            Ok(v) => Err(fail(format!(
+                "{} is {v}: it must be a finite number >= 0",
+                NAMES[i]
+            ))),
+            Err(_) => Err(fail(format!("{} is not a number", NAMES[i]))),
         };
-        let int = |i: usize| {
-            f[i].parse::<u64>()
-                .map_err(|_| fail("a field is not an integer"))
+        let int = |i: usize, max: u64| match f[i].parse::<u64>() {
+            Ok(v) if v <= max => Ok(v),
+            _ => Err(fail(format!(
+                "{} must be an integer from 0 to {max}",
+                NAMES[i]
+            ))),
         };
+        let small = |i: usize| int(i, u64::from(u32::MAX)).map(|v| v as u32);
         Ok(Row {
             estimator: f[0].to_string(),
-            run: int(1)? as u32,
-            checkpoint: int(2)? as u32,
+            run: small(1)?,
+            checkpoint: small(2)?,
             seconds: num(3)?,
-            passes: int(4)?,
-            samples: int(5)?,
+            passes: int(4, u64::MAX)?,
+            samples: int(5, u64::MAX)?,
             region: f[6].to_string(),
             relmse: num(7)?,
             rmse: num(8)?,
@@ -112,6 +133,15 @@ impl Row {
 
 /// Reads a CSV file of rows written by `write_rows`.
 pub fn read_rows(path: &Path) -> Result<Vec<Row>> {
+    read_rows_checked(path, |_| Ok(()))
+}
+
+/// Reads a CSV file of rows, with `check` run on each row; its message is reported with the
+/// file and the row's line.
+fn read_rows_checked(
+    path: &Path,
+    mut check: impl FnMut(&Row) -> std::result::Result<(), String>,
+) -> Result<Vec<Row>> {
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     let mut lines = text.lines();
     if lines.next() != Some(CSV_HEADER) {
@@ -123,8 +153,63 @@ pub fn read_rows(path: &Path) -> Result<Vec<Row>> {
     lines
         .enumerate()
         .filter(|(_, l)| !l.trim().is_empty())
-        .map(|(i, l)| Row::from_csv(l, path, i + 2))
+        .map(|(i, l)| {
+            let row = Row::from_csv(l, path, i + 2)?;
+            check(&row).map_err(|m| {
+                let line = (i + 2).try_into().unwrap_or(u32::MAX);
+                Error::input(
+                    Location {
+                        file: path.to_path_buf(),
+                        line: Some(line),
+                        element: None,
+                    },
+                    m,
+                )
+            })?;
+            Ok(row)
+        })
         .collect()
+}
+
+/// The rows of cell (estimator `e`, run `r`), each checked to belong to it: its label and
+/// run, a checkpoint the experiment has and a region it defines (or none).
+pub fn read_cell_rows(
+    experiment: &Experiment,
+    results: &ResultsDir,
+    e: usize,
+    r: u32,
+) -> Result<Vec<Row>> {
+    let label = &experiment.estimators[e].label;
+    let checkpoints = experiment.checkpoint_budgets().len();
+    let mut seen = std::collections::HashSet::new();
+    read_rows_checked(&results.cell_csv(label, r), |row| {
+        if row.estimator != *label || row.run != r {
+            return Err(format!(
+                "a row of {label} run {r} names {} run {}",
+                row.estimator, row.run
+            ));
+        }
+        if row.checkpoint as usize >= checkpoints {
+            return Err(format!(
+                "checkpoint {} is out of range: the experiment's are numbered 0 to {}",
+                row.checkpoint,
+                checkpoints - 1
+            ));
+        }
+        if !seen.insert((row.checkpoint, row.region.clone())) {
+            return Err(format!(
+                "checkpoint {} (region \"{}\") appears twice",
+                row.checkpoint, row.region
+            ));
+        }
+        if !row.region.is_empty() && !experiment.regions.iter().any(|g| g.label == row.region) {
+            return Err(format!(
+                "region \"{}\" is not one of the experiment's",
+                row.region
+            ));
+        }
+        Ok(())
+    })
 }
 
 /// Writes rows with the header, atomically.
@@ -173,14 +258,15 @@ impl ResultsDir {
     }
 }
 
-/// Loads the experiment's scene with its parameters, and checks that every estimator (and
-/// the reference's) accepts its parameters, so that a misspelt one fails before any
-/// rendering rather than after the reference.
+/// Loads the experiment's scene with its parameters, and checks that every region lies on
+/// its film and every estimator (and the reference's) accepts its parameters, so that a
+/// mistake fails before any rendering rather than after the reference.
 pub fn load_scene(experiment: &Experiment) -> Result<Scene> {
     let scene = Scene::build(mitsuba::load_file_with(
         &experiment.scene,
         &experiment.scene_params,
     )?)?;
+    experiment.check_regions(scene.width(), scene.height())?;
     let mut entries: Vec<(&str, &[String])> = experiment
         .estimators
         .iter()
@@ -313,7 +399,8 @@ pub fn check_fingerprint(results: &ResultsDir, fingerprint: &str) -> Result<()> 
         Ok(_) => Err(Error::input(
             Location::file(&path),
             "these results were made from a different experiment (spec, scene or version); \
-             rerun with --fresh to start over",
+             rerun with --fresh to start over (with --cell K, --fresh discards only that \
+             cell's files: start a cluster run over with `run NAME --prepare --fresh`)",
         )),
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
             std::fs::create_dir_all(&results.dir).map_err(|e| Error::io(&results.dir, e))?;
@@ -338,6 +425,45 @@ pub fn clear_results(results: &ResultsDir) -> Result<()> {
     Ok(())
 }
 
+/// Removes cell (estimator `e`, run `r`)'s own files: its rows, checkpoint images and final
+/// image (for `--cell K --fresh`; every other cell's files stay).
+pub fn clear_cell(experiment: &Experiment, results: &ResultsDir, e: usize, r: u32) -> Result<()> {
+    let label = &experiment.estimators[e].label;
+    let final_image = results.final_image(label, r);
+    let mut files = vec![
+        results.cell_csv(label, r),
+        final_image.with_extension("png"),
+        final_image,
+    ];
+    // Every checkpoint image of this run, also any beyond the current checkpoint count.
+    let checkpoints = results
+        .checkpoint_image(label, r, 0)
+        .parent()
+        .map(Path::to_path_buf);
+    if let Some(dir) = checkpoints.filter(|d| d.is_dir()) {
+        let prefix = format!("run{r}-cp");
+        for entry in std::fs::read_dir(&dir).map_err(|e| Error::io(&dir, e))? {
+            let path = entry.map_err(|e| Error::io(&dir, e))?.path();
+            let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("");
+            let is_mine = name
+                .strip_prefix(&prefix)
+                .and_then(|rest| rest.strip_suffix(".exr"))
+                .is_some_and(|k| !k.is_empty() && k.bytes().all(|b| b.is_ascii_digit()));
+            if is_mine {
+                files.push(path);
+            }
+        }
+    }
+    for f in files {
+        match std::fs::remove_file(&f) {
+            Ok(()) => {}
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {}
+            Err(e) => return Err(Error::io(&f, e)),
+        }
+    }
+    Ok(())
+}
+
 /// True when cell (estimator `e`, run `r`) has all its checkpoint rows and final image.
 pub fn cell_is_complete(
     experiment: &Experiment,
@@ -350,7 +476,7 @@ pub fn cell_is_complete(
     if !csv.exists() || !results.final_image(label, r).exists() {
         return Ok(false);
     }
-    let rows = read_rows(&csv)?;
+    let rows = read_cell_rows(experiment, results, e, r)?;
     let whole = rows.iter().filter(|row| row.region.is_empty()).count();
     Ok(whole == experiment.checkpoint_budgets().len())
 }

@@ -82,7 +82,7 @@ struct ReferenceFile {
 #[serde(deny_unknown_fields)]
 struct EstimatorFile {
     name: String,
-    label: Option<String>,
+    label: Option<Spanned<String>>,
     #[serde(default)]
     params: BTreeMap<String, toml::Value>,
 }
@@ -161,6 +161,9 @@ pub struct Experiment {
     pub reference: ReferenceSource,
     pub estimators: Vec<EstimatorEntry>,
     pub regions: Vec<Region>,
+    /// The line of each `[[region]]` in the spec, for errors found once the film size is
+    /// known (kept apart from `regions`, which the results' fingerprint covers).
+    pub region_lines: Vec<u32>,
 }
 
 /// The most independent runs per estimator (every run is a cell that writes its own
@@ -182,11 +185,7 @@ impl Experiment {
         let fail = |message: String| Error::input(Location::file(path), message);
         // An error at the value `span` covers: the file, its line and the key.
         let fail_at = |span: std::ops::Range<usize>, key: &str, message: String| {
-            let line = 1 + text.as_bytes()[..span.start.min(text.len())]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count();
-            Error::input(Location::at(path, line as u32, key), message)
+            Error::input(Location::at(path, line_of(text, span.start), key), message)
         };
         let file: SpecFile = toml::from_str(text).map_err(|e| fail(e.to_string()))?;
         let dir = path.parent().unwrap_or(Path::new("."));
@@ -239,10 +238,23 @@ impl Experiment {
             let e = spanned.get_ref();
             let fail = |m: String| fail_at(spanned.span(), "[[estimator]]", m);
             check_estimator_name(&e.name).map_err(fail)?;
-            let label = e.label.clone().unwrap_or_else(|| e.name.clone());
+            let label = e
+                .label
+                .as_ref()
+                .map_or_else(|| e.name.clone(), |l| l.get_ref().clone());
+            let fail_label = |m: String| match &e.label {
+                Some(l) => fail_at(l.span(), "label", m),
+                None => fail(m),
+            };
             if !is_safe_label(&label) {
-                return Err(fail(format!(
+                return Err(fail_label(format!(
                     "estimator label \"{label}\": use letters, digits, spaces and . _ - ( ) only"
+                )));
+            }
+            if file_label(&label).starts_with('.') {
+                return Err(fail_label(format!(
+                    "estimator label \"{label}\" starts with a dot: its files would be hidden \
+                     or, for \".\" and \"..\", land outside checkpoints/; do not start it with a dot"
                 )));
             }
             if estimators
@@ -292,6 +304,7 @@ impl Experiment {
         };
 
         let mut regions: Vec<Region> = Vec::new();
+        let mut region_lines = Vec::new();
         for spanned in &file.regions {
             let r = spanned.get_ref();
             let fail = |m: String| fail_at(spanned.span(), "[[region]]", m);
@@ -305,6 +318,7 @@ impl Experiment {
                 )));
             }
             regions.push(r.clone());
+            region_lines.push(line_of(text, spanned.span().start));
         }
 
         let scene_params = file
@@ -331,7 +345,31 @@ impl Experiment {
             reference,
             estimators,
             regions,
+            region_lines,
         })
+    }
+
+    /// Checks that every region lies inside a `width`×`height` film (known once the scene
+    /// is loaded, before anything renders); the error names the spec, the region's line and
+    /// its label.
+    pub fn check_regions(&self, width: u32, height: u32) -> Result<()> {
+        for (k, r) in self.regions.iter().enumerate() {
+            let right = u64::from(r.x) + u64::from(r.width);
+            let bottom = u64::from(r.y) + u64::from(r.height);
+            if right > u64::from(width) || bottom > u64::from(height) {
+                let line = self.region_lines.get(k).copied().unwrap_or(0);
+                return Err(Error::input(
+                    Location::at(&self.spec_path, line, "[[region]]"),
+                    format!(
+                        "region \"{}\" ({}×{} at x = {}, y = {}) reaches past the scene's \
+                         {width}×{height} film: it must lie inside (x + width <= {width}, \
+                         y + height <= {height})",
+                        r.label, r.width, r.height, r.x, r.y
+                    ),
+                ));
+            }
+        }
+        Ok(())
     }
 
     /// The independent cells (estimator index, run), in a fixed order: `--cell K` runs
@@ -363,6 +401,15 @@ impl Experiment {
             }
         }
     }
+}
+
+/// The 1-based line of byte `offset` in `text` (clamped to its end).
+pub fn line_of(text: &str, offset: usize) -> u32 {
+    let newlines = text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count();
+    (1 + newlines).try_into().unwrap_or(u32::MAX)
 }
 
 fn parse_budget(b: &BudgetFile, what: &str, scale: f64) -> std::result::Result<Budget, String> {

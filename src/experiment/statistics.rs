@@ -45,6 +45,28 @@ pub fn mean_interval(values: &[f64], confidence: f64) -> Interval {
     moments.interval(confidence)
 }
 
+/// `mean_interval` for a quantity that cannot be negative (relMSE, RMSE, MAPE, efficiency,
+/// a variance): the Student-t interval with its lower end raised to 0 where it falls below.
+///
+/// The t interval is symmetric, and with few runs it reaches below 0 (with 2 runs t = 12.7).
+/// The true mean is ≥ 0, so the cut drops only values it cannot take: the interval covers the
+/// mean exactly as often as the t interval does. A t interval on ln values would stay positive
+/// too, but it estimates the geometric mean (a log-normal's median), not the arithmetic mean
+/// reported beside it. No values: NaN as for `mean_interval`.
+pub fn nonnegative_mean_interval(values: &[f64], confidence: f64) -> Interval {
+    mean_interval(values, confidence).at_least_zero()
+}
+
+impl Interval {
+    /// The interval with a negative lower end raised to 0 (see `nonnegative_mean_interval`).
+    pub fn at_least_zero(self) -> Interval {
+        Interval {
+            lo: if self.lo < 0.0 { 0.0 } else { self.lo },
+            ..self
+        }
+    }
+}
+
 /// Running count, mean and sum of squared deviations (Welford's update), so that intervals
 /// over millions of pixel terms need no buffer.
 #[derive(Clone, Copy, Debug, Default)]
@@ -293,9 +315,9 @@ pub fn bias_variance(runs: &[Image], reference: &Image) -> Result<BiasVariance> 
     let (t_statistic, p_value) = t_test_zero_mean(&errors);
     Ok(BiasVariance {
         bias2: bias2.interval(CONFIDENCE),
-        variance: variance.interval(CONFIDENCE),
+        variance: variance.interval(CONFIDENCE).at_least_zero(),
         relative_bias2: rel_bias2.interval(CONFIDENCE),
-        relative_variance: rel_variance.interval(CONFIDENCE),
+        relative_variance: rel_variance.interval(CONFIDENCE).at_least_zero(),
         mean_signed_error: errors.interval(CONFIDENCE),
         t_statistic,
         p_value,

@@ -6,9 +6,11 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use serde::Deserialize;
+use toml::Spanned;
 
+use super::SpecText;
 use super::mc_basics::*;
-use crate::error::{Error, Location, Result};
+use crate::error::{Error, Result};
 use crate::experiment::plot::{Band, Series, convergence_plot};
 use crate::io::atomic::write_file_atomically;
 
@@ -19,9 +21,34 @@ pub struct McBasicsSpec {
     pub kind: String,
     pub description: String,
     /// Samples per estimate.
-    pub samples: usize,
+    pub samples: Spanned<usize>,
     #[serde(default)]
     pub seed: u64,
+}
+
+/// Fewest samples per estimate (the σ sweep and the χ² tests need some).
+pub const MIN_SAMPLES: usize = 1000;
+
+/// Most samples per estimate: several estimates keep all their samples in memory (a few
+/// tens of bytes each), and a million take about 2 s.
+pub const MAX_SAMPLES: usize = 10_000_000;
+
+/// The checked spec.
+#[derive(Clone, Debug)]
+pub struct McBasics {
+    pub description: String,
+    pub samples: usize,
+    pub seed: u64,
+}
+
+/// Reads and checks the spec.
+pub fn parse(spec: SpecText) -> Result<McBasics> {
+    let file: McBasicsSpec = spec.parse()?;
+    Ok(McBasics {
+        samples: spec.count(&file.samples, "samples", MIN_SAMPLES..=MAX_SAMPLES)?,
+        description: file.description,
+        seed: file.seed,
+    })
 }
 
 struct Line {
@@ -31,17 +58,10 @@ struct Line {
 }
 
 /// Runs the experiment and writes `summary.csv`, the plots and `README.md` into `out`.
-pub fn run(spec_path: &Path, text: &str, out: &Path) -> Result<()> {
-    let spec: McBasicsSpec =
-        toml::from_str(text).map_err(|e| Error::input(Location::file(spec_path), e.to_string()))?;
-    if spec.samples < 1000 {
-        return Err(Error::input(
-            Location::file(spec_path),
-            "samples must be at least 1000",
-        ));
-    }
-    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
+pub fn run(spec: SpecText, out: &Path) -> Result<()> {
+    let spec = parse(spec)?;
     let (n, seed) = (spec.samples, spec.seed);
+    std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let pi = std::f64::consts::PI;
     let e = std::f64::consts::E;
     let mut lines = vec![

@@ -25,8 +25,10 @@ use std::fmt::Write as _;
 use glam::Vec2;
 use rayon::prelude::*;
 use serde::Deserialize;
+use toml::Spanned;
 
-use crate::error::{Error, Location, Result};
+use super::SpecText;
+use crate::error::{Error, Result};
 use crate::experiment::plot::{Band, Series, convergence_plot};
 use crate::experiment::statistics::{SlopeFit, fit_later_half, later_half};
 use crate::io::atomic::write_file_atomically;
@@ -40,19 +42,124 @@ pub struct SamplingRatesSpec {
     pub kind: String,
     pub description: String,
     /// Grid sides k: the point counts are N = k² (square, so every pattern gets its grid).
-    pub sides: Vec<usize>,
+    pub sides: Spanned<Vec<usize>>,
     /// Sides for one pattern instead of `sides` (CCVT, whose optimisation is slow at large N).
     #[serde(default)]
-    pub pattern_sides: BTreeMap<String, Vec<usize>>,
+    pub pattern_sides: BTreeMap<String, Spanned<Vec<usize>>>,
     /// Independent realisations per (pattern, N).
-    pub realisations: usize,
+    pub realisations: Spanned<usize>,
     /// Random translations of the disk per realisation (see `Settings::shifts`).
-    pub shifts: usize,
+    pub shifts: Spanned<usize>,
     #[serde(default)]
     pub seed: u64,
     /// Patterns to compare (default: all).
-    #[serde(default)]
-    pub patterns: Vec<String>,
+    pub patterns: Option<Spanned<Vec<String>>>,
+}
+
+/// Fewest sides per pattern: the slope is fitted over the later half of them.
+pub const MIN_SIDES: usize = 6;
+
+/// Most sides per pattern.
+pub const MAX_SIDES: usize = 64;
+
+/// Largest grid side: N = 256² = 65536 points, the most a pattern makes for a renderer too.
+pub const MAX_SIDE: usize = 256;
+
+/// Most realisations per (pattern, N).
+pub const MAX_REALISATIONS: usize = 16384;
+
+/// Most translations of the disk per realisation.
+pub const MAX_SHIFTS: usize = 4096;
+
+/// The checked spec.
+#[derive(Clone, Debug)]
+pub struct SamplingRates {
+    pub description: String,
+    /// Each pattern with its sides, in the order they are run.
+    pub patterns: Vec<(Pattern, Vec<usize>)>,
+    pub settings: Settings,
+}
+
+/// Reads and checks the spec.
+pub fn parse(spec: SpecText) -> Result<SamplingRates> {
+    let file: SamplingRatesSpec = spec.parse()?;
+    let check_sides = |sides: &Spanned<Vec<usize>>, key: &str| -> Result<Vec<usize>> {
+        let fail = |m: String| spec.error_at(sides.span(), key, m);
+        let k = sides.get_ref();
+        if !(MIN_SIDES..=MAX_SIDES).contains(&k.len()) {
+            return Err(fail(format!(
+                "{key} needs between {MIN_SIDES} and {MAX_SIDES} grid sides (the slope is \
+                 fitted over the later half), got {}",
+                k.len()
+            )));
+        }
+        if let Some(bad) = k.iter().find(|&&s| !(2..=MAX_SIDE).contains(&s)) {
+            return Err(fail(format!(
+                "{key}: every side must be between 2 and {MAX_SIDE} (N = k² points), got {bad}"
+            )));
+        }
+        if k.windows(2).any(|w| w[0] >= w[1]) {
+            return Err(fail(format!(
+                "{key} must increase strictly: the slope is fitted over the later half, the \
+                 largest N, and needs distinct N there"
+            )));
+        }
+        Ok(k.clone())
+    };
+    let sides = check_sides(&file.sides, "sides")?;
+    let patterns: Vec<Pattern> = match &file.patterns {
+        Some(listed) if !listed.get_ref().is_empty() => {
+            let fail = |m: String| spec.error_at(listed.span(), "patterns", m);
+            let mut out = Vec::new();
+            for name in listed.get_ref() {
+                let p = name.parse::<Pattern>().map_err(fail)?;
+                if out.contains(&p) {
+                    return Err(fail(format!("pattern \"{name}\" is listed twice")));
+                }
+                out.push(p);
+            }
+            out
+        }
+        _ => Pattern::ALL.to_vec(),
+    };
+    let mut sides_of: Vec<(Pattern, Vec<usize>)> = Vec::new();
+    for (name, own) in &file.pattern_sides {
+        let key = format!("pattern_sides.{name}");
+        let pattern = name
+            .parse::<Pattern>()
+            .map_err(|m| spec.error_at(own.span(), &key, m))?;
+        if !patterns.contains(&pattern) {
+            return Err(spec.error_at(
+                own.span(),
+                &key,
+                format!(
+                    "{name} is not among the patterns run ({}): its sides would go unused",
+                    patterns
+                        .iter()
+                        .map(|p| p.name())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            ));
+        }
+        sides_of.push((pattern, check_sides(own, &key)?));
+    }
+    let settings = Settings {
+        realisations: spec.count(&file.realisations, "realisations", 2..=MAX_REALISATIONS)?,
+        shifts: spec.count(&file.shifts, "shifts", 1..=MAX_SHIFTS)?,
+        seed: file.seed,
+    };
+    Ok(SamplingRates {
+        description: file.description,
+        patterns: patterns
+            .into_iter()
+            .map(|p| {
+                let own = sides_of.iter().find(|(q, _)| *q == p).map(|(_, s)| s);
+                (p, own.unwrap_or(&sides).clone())
+            })
+            .collect(),
+        settings,
+    })
 }
 
 /// How each MSE is measured.
@@ -215,45 +322,14 @@ pub fn rates(pattern: Pattern, sides: &[usize], settings: Settings) -> [Curve; 2
 
 /// Runs the experiment into `out`: `summary.csv` (pattern, integrand, slope, slope_se),
 /// one plot per integrand, `README.md`.
-pub fn run(spec_path: &std::path::Path, text: &str, out: &std::path::Path) -> Result<()> {
-    let fail = |m: String| Error::input(Location::file(spec_path), m);
-    let spec: SamplingRatesSpec = toml::from_str(text).map_err(|e| fail(e.to_string()))?;
-    let valid_sides = |sides: &[usize]| sides.len() >= 6 && sides.iter().all(|&k| k >= 2);
-    if !valid_sides(&spec.sides)
-        || !spec.pattern_sides.values().all(|s| valid_sides(s))
-        || spec.realisations < 2
-        || spec.shifts < 1
-    {
-        return Err(fail(
-            "need at least 6 sides (each >= 2; the fit takes the later half) per pattern, 2 \
-             realisations and 1 shift"
-                .into(),
-        ));
-    }
-    let patterns: Vec<Pattern> = if spec.patterns.is_empty() {
-        Pattern::ALL.to_vec()
-    } else {
-        spec.patterns
-            .iter()
-            .map(|p| p.parse::<Pattern>().map_err(&fail))
-            .collect::<Result<_>>()?
-    };
-    let mut sides_of = BTreeMap::new();
-    for (name, sides) in &spec.pattern_sides {
-        sides_of.insert(name.parse::<Pattern>().map_err(&fail)?.name(), sides);
-    }
-    let settings = Settings {
-        realisations: spec.realisations,
-        shifts: spec.shifts,
-        seed: spec.seed,
-    };
+pub fn run(spec: SpecText, out: &std::path::Path) -> Result<()> {
+    let spec = parse(spec)?;
+    let settings = spec.settings;
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
-    let curves: Vec<(Pattern, &[usize], [Curve; 2])> = patterns
+    let curves: Vec<(Pattern, &[usize], [Curve; 2])> = spec
+        .patterns
         .iter()
-        .map(|&pattern| {
-            let sides = sides_of.get(pattern.name()).map_or(&spec.sides[..], |s| s);
-            (pattern, sides, rates(pattern, sides, settings))
-        })
+        .map(|(pattern, sides)| (*pattern, &sides[..], rates(*pattern, sides, settings)))
         .collect();
     let mut csv = String::from("pattern,integrand,slope,slope_se,theory\n");
     let mut md = format!(
@@ -265,7 +341,7 @@ pub fn run(spec_path: &std::path::Path, text: &str, out: &std::path::Path) -> Re
          `cargo run --release -- run sampling-rates`.\n\n\
          | pattern | sides k (fitted) | integrand | fitted slope ± se | theory |\n\
          |---|---|---|---|---|\n",
-        spec.description, spec.realisations, spec.shifts
+        spec.description, settings.realisations, settings.shifts
     );
     for (i, integrand) in Integrand::ALL.into_iter().enumerate() {
         let mut series = Vec::new();

@@ -11,8 +11,10 @@ use std::f64::consts::PI;
 use std::fmt::Write as _;
 
 use serde::Deserialize;
+use toml::Spanned;
 
-use crate::error::{Error, Location, Result};
+use super::SpecText;
+use crate::error::{Error, Result};
 use crate::experiment::plot::viridis;
 use crate::experiment::plot::{Band, Series, convergence_plot};
 use crate::io::atomic::write_file_atomically;
@@ -29,13 +31,42 @@ pub struct SamplingSpectraSpec {
     pub kind: String,
     pub description: String,
     /// Points per realisation.
-    pub points: usize,
+    pub points: Spanned<usize>,
     /// Realisations averaged.
-    pub realisations: usize,
+    pub realisations: Spanned<usize>,
     /// Highest frequency per axis: the image is (2F+1)².
-    pub max_frequency: usize,
+    pub max_frequency: Spanned<usize>,
     #[serde(default)]
     pub seed: u64,
+}
+
+/// Most points per realisation: the phase tables take 32·N·(2F+1) bytes (270 MB at
+/// F = 256), and one realisation costs N·(2F+1)² complex products per pattern.
+pub const MAX_POINTS: usize = 1 << 14;
+
+/// Most realisations averaged.
+pub const MAX_REALISATIONS: usize = 1024;
+
+/// The checked spec.
+#[derive(Clone, Debug)]
+pub struct SamplingSpectra {
+    pub description: String,
+    pub points: usize,
+    pub realisations: usize,
+    pub max_frequency: usize,
+    pub seed: u64,
+}
+
+/// Reads and checks the spec.
+pub fn parse(spec: SpecText) -> Result<SamplingSpectra> {
+    let file: SamplingSpectraSpec = spec.parse()?;
+    Ok(SamplingSpectra {
+        points: spec.count(&file.points, "points", 4..=MAX_POINTS)?,
+        realisations: spec.count(&file.realisations, "realisations", 1..=MAX_REALISATIONS)?,
+        max_frequency: spec.count(&file.max_frequency, "max_frequency", 4..=256)?,
+        description: file.description,
+        seed: file.seed,
+    })
 }
 
 /// The expected periodogram on the (2F+1)² grid of integer frequencies, row-major from
@@ -116,14 +147,8 @@ pub fn radial_mean(spectrum: &[f64], max_frequency: usize) -> Vec<f64> {
 
 /// Runs the experiment into `out`: `PATTERN.png` spectra, `radial.png/.svg`, `radial.csv`,
 /// `README.md`.
-pub fn run(spec_path: &std::path::Path, text: &str, out: &std::path::Path) -> Result<()> {
-    let fail = |m: String| Error::input(Location::file(spec_path), m);
-    let spec: SamplingSpectraSpec = toml::from_str(text).map_err(|e| fail(e.to_string()))?;
-    if spec.points < 4 || spec.realisations == 0 || !(4..=256).contains(&spec.max_frequency) {
-        return Err(fail(
-            "need points >= 4, realisations >= 1 and 4 <= max_frequency <= 256".into(),
-        ));
-    }
+pub fn run(spec: SpecText, out: &std::path::Path) -> Result<()> {
+    let spec = parse(spec)?;
     std::fs::create_dir_all(out).map_err(|e| Error::io(out, e))?;
     let f = spec.max_frequency;
     let side = 2 * f + 1;
