@@ -1592,6 +1592,45 @@ fn meaningless_negative_or_zero_values() {
 }
 
 #[test]
+fn films_with_too_many_pixels_are_errors() {
+    // Each side within its own bound, the product not: an error at the side written last,
+    // also when the sides come from `-D` parameters.
+    let text = with_sphere(
+        r#"<default name="res" value="16384"/>
+<sensor type="perspective"><film type="hdrfilm">
+<integer name="width" value="$res"/>
+<integer name="height" value="$res"/>
+</film></sensor>"#,
+    );
+    let dir = scratch("huge_film");
+    let path = write(&dir, "scene.xml", &text);
+    let desc = load_file(&path).expect("16384² is the largest film");
+    assert_eq!((desc.sensor.film.width, desc.sensor.film.height), (16384, 16384));
+    for res in ["16385", "20000", "65536"] {
+        let params = [("res".to_string(), res.to_string())];
+        let message = mltbench::scene::mitsuba::load_file_with(&path, &params)
+            .unwrap_err()
+            .to_string();
+        assert_names(&message, &path, line_of(&text, "\"height\""));
+        assert!(message.contains("pixels"), "{message}");
+        assert!(message.contains(&format!("width at line {}", line_of(&text, "\"width\""))));
+    }
+    // A default side counts too: 65536 × 576 is fine, 65536 × 8192 is not.
+    let one_side = |extra: &str| {
+        with_sphere(&format!(
+            "<sensor type=\"perspective\"><film type=\"hdrfilm\">\n\
+             <integer name=\"width\" value=\"65536\"/>{extra}</film></sensor>"
+        ))
+    };
+    load_ok("wide_film", &one_side(""));
+    let (message, file) = load_err(
+        "wide_tall_film",
+        &one_side("\n<integer name=\"height\" value=\"8192\"/>"),
+    );
+    assert_names(&message, &file, 5);
+}
+
+#[test]
 fn dangling_ref() {
     let text = scene("<shape type=\"sphere\">\n<ref id=\"nowhere\"/></shape>");
     let (message, file) = load_err("dangling", &text);

@@ -7,6 +7,7 @@ use super::Builder;
 use super::values::Props;
 use super::xml::ElemId;
 use crate::error::Result;
+use crate::image::MAX_PIXELS;
 use crate::math::Transform;
 use crate::scene::{FilmDesc, FilterDesc, FovAxis, SensorDesc, ThinLensDesc};
 
@@ -174,6 +175,32 @@ impl Builder<'_> {
                 }
                 *side = v as u32;
             }
+        }
+        // Each side is bounded above, their product here: a 65536² film would ask for
+        // hundreds of GiB of accumulators and abort the process.
+        let pixels = u64::from(film.width) * u64::from(film.height);
+        if pixels > MAX_PIXELS {
+            // Name the side written last (the other may be a default), and both lines.
+            let at = ["height", "width"]
+                .into_iter()
+                .filter(|name| props.has(name))
+                .max_by_key(|name| tree.elem(props.elem_of(name)).line)
+                .map_or(elem, |name| props.elem_of(name));
+            let lines: Vec<String> = ["width", "height"]
+                .into_iter()
+                .filter(|name| props.has(name))
+                .map(|name| format!("{name} at line {}", tree.elem(props.elem_of(name)).line))
+                .collect();
+            return Err(tree.error(
+                at,
+                format!(
+                    "a film of {} × {} = {pixels} pixels ({}) is larger than mltbench renders \
+                     (at most {MAX_PIXELS} pixels, e.g. 16384 × 16384)",
+                    film.width,
+                    film.height,
+                    lines.join(", ")
+                ),
+            ));
         }
         // Output format settings do not change the radiance mltbench computes.
         props.ignore(&[
