@@ -1592,6 +1592,90 @@ fn meaningless_negative_or_zero_values() {
 }
 
 #[test]
+fn reflectances_and_transmittances_above_one_are_errors() {
+    // Every reflectance-like parameter of every BSDF, in every way of writing a colour.
+    let params: &[(&str, &[&str])] = &[
+        ("diffuse", &["reflectance"]),
+        ("conductor", &["specular_reflectance"]),
+        ("roughconductor", &["specular_reflectance"]),
+        (
+            "dielectric",
+            &["specular_reflectance", "specular_transmittance"],
+        ),
+        (
+            "thindielectric",
+            &["specular_reflectance", "specular_transmittance"],
+        ),
+        (
+            "roughdielectric",
+            &["specular_reflectance", "specular_transmittance"],
+        ),
+        ("plastic", &["diffuse_reflectance", "specular_reflectance"]),
+        (
+            "roughplastic",
+            &["diffuse_reflectance", "specular_reflectance"],
+        ),
+        ("phong", &["diffuse_reflectance", "specular_reflectance"]),
+        ("blinn", &["diffuse_reflectance", "specular_reflectance"]),
+        ("ward", &["diffuse_reflectance", "specular_reflectance"]),
+    ];
+    let values = [
+        "<rgb name=\"NAME\" value=\"5\"/>",
+        "<rgb name=\"NAME\" value=\"0.5, 1.0001, 0.5\"/>",
+        "<float name=\"NAME\" value=\"1.5\"/>",
+        "<integer name=\"NAME\" value=\"2\"/>",
+        "<spectrum name=\"NAME\" value=\"5\"/>",
+        "<spectrum name=\"NAME\" value=\"400:5, 700:5\"/>",
+        "<spectrum name=\"NAME\" value=\"400:0.5, 550:-0.1, 700:0.5\"/>",
+    ];
+    for (bsdf, names) in params {
+        for name in *names {
+            for value in values {
+                let body = format!(
+                    "<shape type=\"sphere\"><bsdf type=\"{bsdf}\">\n{}</bsdf></shape>",
+                    value.replace("NAME", name)
+                );
+                let (message, file) = load_err("reflectance_range", &scene(&body));
+                assert_names(&message, &file, 3);
+                assert!(message.contains("[0, 1]"), "{message}");
+            }
+        }
+    }
+    // Radiance, eta, k and alpha are not bounded by 1.
+    bsdf_of(
+        r#"<bsdf type="roughconductor"><rgb name="eta" value="2"/><rgb name="k" value="5"/>
+           <float name="alpha" value="0.9"/></bsdf><emitter type="area"><rgb name="radiance" value="5"/></emitter>"#,
+        "unbounded",
+    );
+    // A spectrum inside [0, 1] whose RGB leaves the gamut is clamped as Mitsuba 3.9.1 does
+    // (measured: [1, 0.089609, 1]), with a warning naming the line.
+    let text = scene(
+        "<shape type=\"sphere\"><bsdf type=\"diffuse\">\n\
+         <spectrum name=\"reflectance\" value=\"360:1, 480:1, 500:0, 560:0, 580:1, 830:1\"/>\
+         </bsdf></shape>",
+    );
+    let desc = load_ok("out_of_gamut", &text);
+    let BsdfDesc::Diffuse { reflectance } = desc.bsdfs[0] else {
+        panic!("{:?}", desc.bsdfs)
+    };
+    assert_eq!((reflectance.0[0], reflectance.0[2]), (1.0, 1.0));
+    assert!((reflectance.0[1] - 0.089609).abs() < 1e-5, "{reflectance:?}");
+    let warning = desc
+        .warnings
+        .iter()
+        .find(|w| w.contains("clamped"))
+        .expect("a clamping warning");
+    assert!(warning.contains("scene.xml:3"), "{warning}");
+    // The glossy extensions' two lobes must not add up to more than 1.
+    let text = scene(
+        "<shape type=\"sphere\"><bsdf type=\"phong\"><rgb name=\"diffuse_reflectance\" value=\"0.6\"/>\n\
+         <rgb name=\"specular_reflectance\" value=\"0.2, 0.5, 0.2\"/></bsdf></shape>",
+    );
+    let message = load_err_at("phong_sum", &text, 3);
+    assert!(message.contains("more light than it receives"), "{message}");
+}
+
+#[test]
 fn films_with_too_many_pixels_are_errors() {
     // Each side within its own bound, the product not: an error at the side written last,
     // also when the sides come from `-D` parameters.
