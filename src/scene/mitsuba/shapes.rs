@@ -162,6 +162,7 @@ impl Builder<'_> {
                 radiance,
                 shape: index,
             });
+            self.desc.emitter_locations.push(tree.location(emitter_elem));
             self.desc.emitters.len() - 1
         });
         let name = match tree.attr(elem, "id") {
