@@ -316,3 +316,41 @@ fn envmap_image_errors_name_the_scene_line_and_the_image() {
         assert!(message.contains(name) && message.contains(what), "{message}");
     }
 }
+
+/// An area emitter whose shape has no area in f32 is an error at the emitter's line, for
+/// spheres, disks and meshes alike.
+#[test]
+fn emitters_of_zero_area_are_errors() {
+    let emitter = "\n<emitter type=\"area\"/>";
+    for (shape, when) in [
+        (
+            format!("<shape type=\"sphere\"><float name=\"radius\" value=\"1e-40\"/>{emitter}</shape>"),
+            "build",
+        ),
+        (
+            format!("<shape type=\"disk\"><transform name=\"to_world\"><scale x=\"1e-20\" y=\"1e-20\" z=\"1e30\"/></transform>{emitter}</shape>"),
+            "build",
+        ),
+        (
+            format!("<shape type=\"rectangle\"><transform name=\"to_world\"><scale x=\"1e-25\" y=\"1e-25\" z=\"1e30\"/></transform>{emitter}</shape>"),
+            "load",
+        ),
+    ] {
+        let text = with_sphere(&shape);
+        let line = line_of(&text, "<emitter");
+        let dir = scratch("zero_area");
+        let message = match (load_written(&dir, &text), when) {
+            (Ok(desc), "build") => LightSet::build(&desc).unwrap_err().to_string(),
+            (Err(e), "load") => e.to_string(),
+            (other, _) => panic!("{when}: {:?}\n{text}", other.map(|_| ())),
+        };
+        assert_names(&message, &dir.join("scene.xml"), line);
+        assert!(message.contains("emit"), "{message}");
+    }
+    // Small but representable: builds.
+    let desc = load_ok(
+        "small_area",
+        &with_sphere("<shape type=\"sphere\"><float name=\"radius\" value=\"1e-10\"/><emitter type=\"area\"/></shape>"),
+    );
+    LightSet::build(&desc).unwrap();
+}

@@ -147,6 +147,12 @@ impl Builder<'_> {
         props.finish()?;
 
         let Some(geometry) = geometry else {
+            if let Some((emitter_elem, _)) = emitter {
+                return Err(tree.error(
+                    emitter_elem,
+                    "this area emitter's mesh has no triangles left: it cannot emit",
+                ));
+            }
             let w = tree.warning(elem, "the mesh has no triangles left: shape skipped");
             self.desc.warnings.push(w);
             return Ok(());
