@@ -255,6 +255,20 @@ fn obj_keeps_normals_and_uvs_only_when_every_vertex_has_them() {
 }
 
 #[test]
+fn obj_reads_x_y_z_and_ignores_further_vertex_values() {
+    // As Mitsuba 3.9.1 does (measured): a `w` does not divide the position, vertex colours
+    // are ignored, a third texture coordinate too.
+    let dir = temp_dir("obj-extra-values");
+    let obj = "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 2\nvt 0.5 0.5 0.7\nvt 0.5 0.5\nvt 0.5 0.2 0.1\nf 1/1 2/2 3/3\n";
+    let mesh = read_obj(&write(&dir, "extra.obj", obj.as_bytes())).unwrap();
+    assert_eq!(mesh.positions, vec![Vec3::ZERO, Vec3::X, Vec3::Y]);
+    assert_eq!(
+        mesh.uvs,
+        Some(vec![Vec2::new(0.5, 0.5), Vec2::new(0.5, 0.5), Vec2::new(0.5, 0.2)])
+    );
+}
+
+#[test]
 fn empty_obj_is_an_empty_mesh() {
     let dir = temp_dir("empty");
     let mesh = read_obj(&write(&dir, "empty.obj", b"# nothing\n")).unwrap();
@@ -460,7 +474,17 @@ fn obj_errors_name_the_file_and_the_face() {
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//1\n",
     );
     assert!(e.contains("zero length"), "{e}");
-    obj_error(&dir, "bad_v.obj", "v 0 0\nf 1 1 1\n");
+    assert!(e.contains(":4:"), "{e}");
+    // Vertex records: too few numbers or words that are not numbers, with the line.
+    for (name, text, line, what) in [
+        ("bad_v.obj", "v 0 0\nf 1 1 1\n", 1, "3 numbers"),
+        ("word_v.obj", "v 0 0 0\nv 1 0 0\nv 0 1 abc\nf 1 2 3\n", 3, "`abc`"),
+        ("short_vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5\nf 1/1 2/1 3/1\n", 4, "2 numbers"),
+        ("short_vn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n\nvn 0 0\nf 1//1 2//1 3//1\n", 5, "3 numbers"),
+    ] {
+        let e = obj_error(&dir, name, text);
+        assert!(e.contains(&format!("{name}:{line}:")) && e.contains(what), "{e}");
+    }
     let path = write(&dir, "latin1.obj", b"v 0 0 0 \xff\n");
     error_text(read_obj(&path), &path);
 }
