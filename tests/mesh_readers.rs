@@ -264,7 +264,11 @@ fn obj_reads_x_y_z_and_ignores_further_vertex_values() {
     assert_eq!(mesh.positions, vec![Vec3::ZERO, Vec3::X, Vec3::Y]);
     assert_eq!(
         mesh.uvs,
-        Some(vec![Vec2::new(0.5, 0.5), Vec2::new(0.5, 0.5), Vec2::new(0.5, 0.2)])
+        Some(vec![
+            Vec2::new(0.5, 0.5),
+            Vec2::new(0.5, 0.5),
+            Vec2::new(0.5, 0.2)
+        ])
     );
 }
 
@@ -343,7 +347,48 @@ fn ply_errors_name_the_file_and_the_record() {
     assert!(e.contains("face") || e.contains("too short"), "{e}");
     let cut = &text[..text.find("0.75").unwrap()];
     let e = ply_error(&dir, "cut_ascii.ply", cut.as_bytes());
-    assert!(e.contains("ends early") || e.contains("too short"), "{e}");
+    assert!(
+        e.contains(":27: vertex 4 has 10 values, expected 12"),
+        "{e}"
+    );
+    let cut = &text[..text.find("18 3").unwrap()];
+    let e = ply_error(&dir, "cut_ascii_line.ply", cut.as_bytes());
+    assert!(e.contains(":30: face 1") && e.contains("ends early"), "{e}");
+
+    // Ascii records are lines: too few or too many values on one is an error naming it,
+    // counting list lengths as written.
+    let line_of = |needle: &str| 1 + text.lines().position(|l| l.starts_with(needle)).unwrap();
+    let second_vertex = text.lines().nth(23).unwrap().to_string();
+    for (name, from, to, message) in [
+        (
+            "short_vertex.ply",
+            second_vertex.as_str(),
+            "0 1",
+            "vertex 1 has 2 values, expected at least 10",
+        ),
+        (
+            "long_vertex.ply",
+            second_vertex.as_str(),
+            &format!("{second_vertex} 7") as &str,
+            "vertex 1 has 13 values, expected 12",
+        ),
+        (
+            "short_face.ply",
+            "17 4 0 1 2 3 0.5",
+            "17 4 0 1 2",
+            "face 0 has 5 values, expected 7",
+        ),
+        (
+            "long_face.ply",
+            "18 3 1 4 2 0.25",
+            "18 3 1 4 2 0 0.25",
+            "face 1 has 7 values, expected 6",
+        ),
+    ] {
+        let e = ply_error(&dir, name, text.replacen(from, to, 1).as_bytes());
+        let line = line_of(from);
+        assert!(e.contains(&format!("{name}:{line}: {message}")), "{e}");
+    }
 
     // Counts that do not match the data: one vertex too many declared, one too few.
     ply_error(
@@ -357,7 +402,10 @@ fn ply_errors_name_the_file_and_the_record() {
         "fewer.ply",
         text.replace("element face 2", "element face 1").as_bytes(),
     );
-    assert!(e.contains("follow the last element"), "{e}");
+    assert!(
+        e.contains(":30:") && e.contains("follow the last element"),
+        "{e}"
+    );
     // A header count far beyond the file size is rejected before anything is allocated.
     let e = ply_error(
         &dir,
@@ -478,12 +526,30 @@ fn obj_errors_name_the_file_and_the_face() {
     // Vertex records: too few numbers or words that are not numbers, with the line.
     for (name, text, line, what) in [
         ("bad_v.obj", "v 0 0\nf 1 1 1\n", 1, "3 numbers"),
-        ("word_v.obj", "v 0 0 0\nv 1 0 0\nv 0 1 abc\nf 1 2 3\n", 3, "`abc`"),
-        ("short_vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5\nf 1/1 2/1 3/1\n", 4, "2 numbers"),
-        ("short_vn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n\nvn 0 0\nf 1//1 2//1 3//1\n", 5, "3 numbers"),
+        (
+            "word_v.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 abc\nf 1 2 3\n",
+            3,
+            "`abc`",
+        ),
+        (
+            "short_vt.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5\nf 1/1 2/1 3/1\n",
+            4,
+            "2 numbers",
+        ),
+        (
+            "short_vn.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\n\nvn 0 0\nf 1//1 2//1 3//1\n",
+            5,
+            "3 numbers",
+        ),
     ] {
         let e = obj_error(&dir, name, text);
-        assert!(e.contains(&format!("{name}:{line}:")) && e.contains(what), "{e}");
+        assert!(
+            e.contains(&format!("{name}:{line}:")) && e.contains(what),
+            "{e}"
+        );
     }
     let path = write(&dir, "latin1.obj", b"v 0 0 0 \xff\n");
     error_text(read_obj(&path), &path);
