@@ -313,7 +313,10 @@ fn envmap_image_errors_name_the_scene_line_and_the_image() {
         let desc = load_written(&dir, &text).unwrap();
         let message = LightSet::build(&desc).unwrap_err().to_string();
         assert_names(&message, &dir.join("scene.xml"), line_of(&text, "envmap"));
-        assert!(message.contains(name) && message.contains(what), "{message}");
+        assert!(
+            message.contains(name) && message.contains(what),
+            "{message}"
+        );
     }
 }
 
@@ -324,15 +327,21 @@ fn emitters_of_zero_area_are_errors() {
     let emitter = "\n<emitter type=\"area\"/>";
     for (shape, when) in [
         (
-            format!("<shape type=\"sphere\"><float name=\"radius\" value=\"1e-40\"/>{emitter}</shape>"),
+            format!(
+                "<shape type=\"sphere\"><float name=\"radius\" value=\"1e-40\"/>{emitter}</shape>"
+            ),
             "build",
         ),
         (
-            format!("<shape type=\"disk\"><transform name=\"to_world\"><scale x=\"1e-20\" y=\"1e-20\" z=\"1e30\"/></transform>{emitter}</shape>"),
+            format!(
+                "<shape type=\"disk\"><transform name=\"to_world\"><scale x=\"1e-20\" y=\"1e-20\" z=\"1e30\"/></transform>{emitter}</shape>"
+            ),
             "build",
         ),
         (
-            format!("<shape type=\"rectangle\"><transform name=\"to_world\"><scale x=\"1e-25\" y=\"1e-25\" z=\"1e30\"/></transform>{emitter}</shape>"),
+            format!(
+                "<shape type=\"rectangle\"><transform name=\"to_world\"><scale x=\"1e-25\" y=\"1e-25\" z=\"1e30\"/></transform>{emitter}</shape>"
+            ),
             "load",
         ),
     ] {
@@ -350,7 +359,9 @@ fn emitters_of_zero_area_are_errors() {
     // Small but representable: builds.
     let desc = load_ok(
         "small_area",
-        &with_sphere("<shape type=\"sphere\"><float name=\"radius\" value=\"1e-10\"/><emitter type=\"area\"/></shape>"),
+        &with_sphere(
+            "<shape type=\"sphere\"><float name=\"radius\" value=\"1e-10\"/><emitter type=\"area\"/></shape>",
+        ),
     );
     LightSet::build(&desc).unwrap();
 }

@@ -1659,7 +1659,10 @@ fn reflectances_and_transmittances_above_one_are_errors() {
         panic!("{:?}", desc.bsdfs)
     };
     assert_eq!((reflectance.0[0], reflectance.0[2]), (1.0, 1.0));
-    assert!((reflectance.0[1] - 0.089609).abs() < 1e-5, "{reflectance:?}");
+    assert!(
+        (reflectance.0[1] - 0.089609).abs() < 1e-5,
+        "{reflectance:?}"
+    );
     let warning = desc
         .warnings
         .iter()
@@ -1689,7 +1692,10 @@ fn films_with_too_many_pixels_are_errors() {
     let dir = scratch("huge_film");
     let path = write(&dir, "scene.xml", &text);
     let desc = load_file(&path).expect("16384² is the largest film");
-    assert_eq!((desc.sensor.film.width, desc.sensor.film.height), (16384, 16384));
+    assert_eq!(
+        (desc.sensor.film.width, desc.sensor.film.height),
+        (16384, 16384)
+    );
     for res in ["16385", "20000", "65536"] {
         let params = [("res".to_string(), res.to_string())];
         let message = mltbench::scene::mitsuba::load_file_with(&path, &params)

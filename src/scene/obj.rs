@@ -76,7 +76,10 @@ fn geometry_records(path: &Path, text: &str) -> Result<String> {
                 };
                 let record_error = |message: String| {
                     let shown: String = line.trim().chars().take(40).collect();
-                    Error::input(Location::at(path, line_number, format!("`{shown}`")), message)
+                    Error::input(
+                        Location::at(path, line_number, format!("`{shown}`")),
+                        message,
+                    )
                 };
                 let values: Vec<&str> = words.take(needed).collect();
                 if values.len() < needed {
