@@ -314,6 +314,43 @@ fn missing_files_are_io_errors_naming_the_file() {
 }
 
 #[test]
+fn readers_refuse_directories_and_fifos_without_opening_them() {
+    let dir = temp_dir("not-files");
+    let fifo = dir.join("pipe.ply");
+    let has_fifo = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    let mut inputs = vec![(dir.clone(), "is a directory")];
+    if has_fifo {
+        inputs.push((fifo, "not a regular file"));
+    }
+    for (path, what) in inputs {
+        // On another thread: a reader that opened the FIFO would block forever.
+        let (send, receive) = std::sync::mpsc::channel();
+        let p = path.clone();
+        std::thread::spawn(move || {
+            let errors = [
+                read_ply(&p).err().map(|e| e.to_string()),
+                read_obj(&p).err().map(|e| e.to_string()),
+                mltbench::io::exr::read_exr(&p).err().map(|e| e.to_string()),
+            ];
+            send.send(errors)
+        });
+        let errors = receive
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .expect("a reader blocked");
+        for error in errors {
+            let error = error.expect("an error");
+            assert!(
+                error.contains(&path.display().to_string()) && error.contains(what),
+                "{error}"
+            );
+        }
+    }
+}
+
+#[test]
 fn ply_errors_name_the_file_and_the_record() {
     let dir = temp_dir("ply-errors");
     let text = ascii_ply();

@@ -1879,6 +1879,66 @@ fn missing_files_are_named() {
     assert_names(&message, &dir.join("scene.xml"), 3);
 }
 
+/// Runs `load` on another thread: a read that blocks (a FIFO) fails the test instead of
+/// hanging it.
+fn within_seconds<T: Send + 'static>(load: impl FnOnce() -> T + Send + 'static) -> T {
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || send.send(load()));
+    receive
+        .recv_timeout(std::time::Duration::from_secs(20))
+        .expect("the load blocked")
+}
+
+#[test]
+fn inputs_that_are_not_regular_files_are_errors() {
+    let dir = scratch("not_files");
+    std::fs::create_dir_all(dir.join("adir")).unwrap();
+    for (body, needle) in [
+        (
+            "<shape type=\"obj\">\n<string name=\"filename\" value=\"adir\"/></shape>",
+            "adir",
+        ),
+        ("<include filename=\"adir\"/>", "adir"),
+        (
+            "<emitter type=\"envmap\">\n<string name=\"filename\" value=\"adir\"/></emitter>",
+            "adir",
+        ),
+    ] {
+        let text = with_sphere(body);
+        let message = load_written(&dir, &text).unwrap_err().to_string();
+        assert_names(&message, &dir.join("scene.xml"), line_of(&text, needle));
+        assert!(message.contains("is a directory"), "{message}");
+    }
+    // A FIFO blocks whoever opens it for reading until someone writes: refused unopened,
+    // as the scene itself, a mesh, an include or an environment map.
+    let fifo = dir.join("pipe");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        eprintln!("mkfifo unavailable: FIFO cases skipped");
+        return;
+    }
+    let path = fifo.clone();
+    let message = within_seconds(move || load_file(&path).map(|_| ()))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("pipe") && message.contains("not a regular file"),
+        "{message}"
+    );
+    for body in [
+        "<shape type=\"ply\">\n<string name=\"filename\" value=\"pipe\"/></shape>",
+        "<include filename=\"pipe\"/>",
+        "<emitter type=\"envmap\">\n<string name=\"filename\" value=\"pipe\"/></emitter>",
+    ] {
+        let text = with_sphere(body);
+        let scene_dir = dir.clone();
+        let loaded = within_seconds(move || load_written(&scene_dir, &text).map(|_| ()));
+        let message = loaded.unwrap_err().to_string();
+        assert!(message.contains("not a regular file"), "{message}");
+        assert!(message.contains("scene.xml:"), "{message}");
+    }
+}
+
 #[test]
 fn errors_inside_included_files_name_that_file() {
     let dir = scratch("include_errors");

@@ -87,6 +87,7 @@ pub fn read_exr(path: &Path) -> Result<Image> {
         .all_attributes()
         .non_parallel();
     // Check the sizes the header claims before anything is allocated for them.
+    crate::io::check_input_file(path)?;
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let meta = exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false)
         .map_err(|e| exr_error(path, "not a readable", e))?;

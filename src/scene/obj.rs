@@ -26,6 +26,7 @@ use crate::error::{Error, Location, Result};
 
 /// Reads every object of an OBJ file into one mesh in object space.
 pub fn read_obj(path: &Path) -> Result<TriangleMesh> {
+    crate::io::check_input_file(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let text = std::str::from_utf8(&bytes).map_err(|e| {
         Error::input(

@@ -21,6 +21,7 @@ use crate::error::{Error, Location, Result};
 
 /// Reads a PLY file into a mesh in object space.
 pub fn read_ply(path: &Path) -> Result<TriangleMesh> {
+    crate::io::check_input_file(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let header = parse_header(path, &bytes)?;
     let body = match header.format {

@@ -177,7 +177,8 @@ impl Tree {
     }
 
     /// `resolve_file`, or the message for a file that does not exist:
-    /// `{what} "{name}" not found (searched: …)`, every place looked at listed.
+    /// `{what} "{name}" not found (searched: …)`, every place looked at listed; or, when
+    /// the name exists but is no regular file, what it is.
     pub fn find_file(
         &self,
         name: &str,
@@ -186,6 +187,12 @@ impl Tree {
     ) -> std::result::Result<PathBuf, String> {
         let (found, searched) = self.resolve_file(name, named_in);
         found.ok_or_else(|| {
+            for path in &searched {
+                if let Ok(meta) = std::fs::metadata(path) {
+                    let why = crate::io::not_a_file(&meta);
+                    return format!("{what} \"{name}\" {why} ({})", path.display());
+                }
+            }
             let list: Vec<String> = searched.iter().map(|p| p.display().to_string()).collect();
             format!(
                 "{what} \"{name}\" not found (searched: {})",
@@ -226,6 +233,7 @@ fn parent_dir(file: &Path) -> &Path {
 
 /// Reads a file as scene text: it must be UTF-8 without NUL bytes.
 pub(super) fn read_text(path: &Path) -> Result<String> {
+    crate::io::check_input_file(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let line_at =
         |offset: usize| 1 + bytes[..offset].iter().filter(|&&b| b == b'\n').count() as u32;
