@@ -365,6 +365,20 @@ fn ply_errors_name_the_file_and_the_record() {
         text.replace("ascii 1.0", "utf16 1.0").as_bytes(),
     );
     assert!(e.contains("unknown PLY format"), "{e}");
+    // 1.0 is the only version, and nothing may follow it.
+    for format in [
+        "ascii 7.5 junk",
+        "ascii 1.0 junk",
+        "ascii",
+        "binary_little_endian 2.0",
+    ] {
+        let e = ply_error(
+            &dir,
+            "version.ply",
+            text.replace("ascii 1.0", format).as_bytes(),
+        );
+        assert!(e.contains(":2:") && e.contains("1.0"), "{e}");
+    }
     ply_error(
         &dir,
         "no_end.ply",

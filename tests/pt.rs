@@ -388,6 +388,20 @@ fn floor_under_a_point_light_follows_the_inverse_square_law() {
 }
 
 #[test]
+fn depth_parameters_are_bounded_as_in_the_scene() {
+    // <integrator> refuses rr_depth 0 and max_depth below -1; so does --set.
+    let scene = furnace("sphere", "0.5", "1", -1, "");
+    for bad in ["rr_depth=0", "max_depth=-2"] {
+        let params = Params::parse(&[bad]).unwrap();
+        let error = estimator::create("pt", &params, &scene, 1)
+            .err()
+            .unwrap_or_else(|| panic!("{bad} accepted"))
+            .to_string();
+        assert!(error.contains(bad), "{error}");
+    }
+}
+
+#[test]
 fn a_tiny_sphere_light_is_a_point_light() {
     // A sphere of radius r and radiance L has intensity I = π r² L in every direction. At
     // r = 1e-10 its sampling densities (~1e20) square beyond f32: the MIS weight must hold.

@@ -506,6 +506,17 @@ fn other_filters_warn_and_use_box() {
         warning.contains(&format!("scene.xml:{}", line_of(&text, "tent"))),
         "{warning}"
     );
+    // Not a Mitsuba filter at all: an error, like an unknown BSDF or shape type.
+    let text = with_sphere(
+        r#"<sensor type="perspective"><film type="hdrfilm">
+<rfilter type="bogus"/>
+</film></sensor>"#,
+    );
+    let message = load_err_at("bogus_filter", &text, line_of(&text, "bogus"));
+    assert!(
+        message.contains("unknown reconstruction filter"),
+        "{message}"
+    );
 }
 
 #[test]
@@ -1151,6 +1162,53 @@ fn zero_roughness_is_raised_with_a_warning() {
     assert!(desc.warnings.iter().any(|w| w.contains("roughness")));
 }
 
+#[test]
+fn roughness_is_bounded_above() {
+    // Above 1: loads with a warning; above 100 (a black surface, surely a typo): an error.
+    for kind in ["roughconductor", "roughdielectric", "roughplastic", "ward"] {
+        let desc = load_ok(
+            "alpha_large",
+            &scene(&format!(
+                "<shape type=\"sphere\"><bsdf type=\"{kind}\">\n<float name=\"alpha\" value=\"2\"/></bsdf></shape>"
+            )),
+        );
+        assert!(
+            desc.warnings
+                .iter()
+                .any(|w| w.contains("roughness 2") && w.contains("scene.xml:3")),
+            "{kind}: {:?}",
+            desc.warnings
+        );
+        for value in ["1e30", "101"] {
+            let message = load_err_at(
+                "alpha_huge",
+                &scene(&format!(
+                    "<shape type=\"sphere\"><bsdf type=\"{kind}\">\n<float name=\"alpha\" value=\"{value}\"/></bsdf></shape>"
+                )),
+                3,
+            );
+            assert!(message.contains("roughness"), "{message}");
+        }
+    }
+    let message = load_err_at(
+        "alpha_v_huge",
+        &scene(
+            "<shape type=\"sphere\"><bsdf type=\"roughconductor\"><float name=\"alpha_u\" value=\"0.1\"/>\n<float name=\"alpha_v\" value=\"1e30\"/></bsdf></shape>",
+        ),
+        3,
+    );
+    assert!(
+        message.contains("alpha") || message.contains("roughness"),
+        "{message}"
+    );
+    load_ok(
+        "alpha_100",
+        &scene(
+            r#"<shape type="sphere"><bsdf type="roughconductor"><float name="alpha" value="100"/></bsdf></shape>"#,
+        ),
+    );
+}
+
 // ---------------------------------------------------------------------------------------
 // Shapes
 
@@ -1784,6 +1842,42 @@ fn root_and_version_are_checked() {
         "<scene version=\"0.6.0\"><shape type=\"sphere\"/></scene>",
     );
     assert!(message.contains("0.6.0"), "{message}");
+    // Newer than Mitsuba 3: loads (Mitsuba 3.9.1 says nothing) with a warning, also when it
+    // is an included file that is newer.
+    let desc = load_ok(
+        "new_version",
+        "<scene version=\"4.0.0\"><shape type=\"sphere\"/></scene>",
+    );
+    assert!(
+        desc.warnings
+            .iter()
+            .any(|w| w.contains("4.0.0") && w.contains("scene.xml:1")),
+        "{:?}",
+        desc.warnings
+    );
+    let dir = scratch("new_version_include");
+    write(
+        &dir,
+        "part.xml",
+        "<scene version=\"5.1.0\"><shape type=\"sphere\"/></scene>",
+    );
+    let desc = load_written(&dir, &scene("<include filename=\"part.xml\"/>")).unwrap();
+    assert!(
+        desc.warnings
+            .iter()
+            .any(|w| w.contains("5.1.0") && w.contains("part.xml:1")),
+        "{:?}",
+        desc.warnings
+    );
+    let desc = load_ok(
+        "current_version",
+        "<scene version=\"3.9.1\"><shape type=\"sphere\"/></scene>",
+    );
+    assert!(
+        !desc.warnings.iter().any(|w| w.contains("newer")),
+        "{:?}",
+        desc.warnings
+    );
 }
 
 #[test]
@@ -1839,6 +1933,10 @@ fn unsupported_features_say_so() {
         (
             "<shape type=\"rectangle\"><medium type=\"homogeneous\" name=\"interior\"/></shape>",
             "<medium type=\"homogeneous\" name=\"interior\">",
+        ),
+        (
+            "<shape type=\"sphere\"><emitter type=\"area\"><spectrum type=\"blackbody\" name=\"radiance\"><float name=\"temperature\" value=\"5000\"/></spectrum></emitter></shape>",
+            "<spectrum type=\"blackbody\" name=\"radiance\">",
         ),
     ] {
         let message = load_err_at("unsupported", &with_sphere(body), 3);

@@ -234,6 +234,17 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
                         ));
                     }
                 });
+                // 1.0 is the only version of the format there is.
+                if rest.get(1..) != Some(&["1.0"][..]) {
+                    return Err(header_error(
+                        line_number,
+                        format!(
+                            "expected `format {} 1.0`, got `format {}`",
+                            rest[0],
+                            rest.join(" ")
+                        ),
+                    ));
+                }
             }
             "element" => {
                 let [name, count] = rest[..] else {

@@ -29,6 +29,11 @@ const IOR_AIR: f32 = 1.000277;
 const IOR_POLYPROPYLENE: f32 = 1.49;
 /// Smallest microfacet roughness Mitsuba accepts.
 const MIN_ALPHA: f32 = 1e-4;
+/// Largest roughness mltbench accepts. α is the microfacets' RMS slope: Mitsuba calls 0.3–0.7
+/// extremely rough, and as α grows the microfacet models reflect less and less (at α = 100 a
+/// rough conductor sphere returns under 10⁻⁶ of the light, in Mitsuba 3.9.1 as here). A
+/// larger value is a typo, not a material; above 1 mltbench warns.
+const MAX_ALPHA: f32 = 100.0;
 
 /// Mitsuba BSDF plugins mltbench does not implement (a clearer message than "unknown").
 const UNSUPPORTED: &[&str] = &[
@@ -358,6 +363,25 @@ impl Builder<'_> {
                     props.elem_of(name),
                     format!("roughness must not be negative, got {alpha}"),
                 ));
+            }
+            if alpha > MAX_ALPHA {
+                return Err(tree.error(
+                    props.elem_of(name),
+                    format!(
+                        "roughness {alpha} is above {MAX_ALPHA}: the surface would be black \
+                         (α is the microfacets' RMS slope; 0.3–0.7 is already extremely rough)"
+                    ),
+                ));
+            }
+            if alpha > 1.0 {
+                let w = tree.warning(
+                    props.elem_of(name),
+                    &format!(
+                        "roughness {alpha} is above 1 (0.3–0.7 is already extremely rough): \
+                         the surface darkens as α grows"
+                    ),
+                );
+                self.desc.warnings.push(w);
             }
             if alpha < MIN_ALPHA {
                 let w = tree.warning(

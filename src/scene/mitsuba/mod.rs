@@ -83,6 +83,7 @@ impl<'a> Builder<'a> {
         let desc = SceneDescription {
             source: path.to_path_buf(),
             files_read: tree.files.clone(),
+            warnings: tree.warnings.clone(),
             ..SceneDescription::default()
         };
         Builder {

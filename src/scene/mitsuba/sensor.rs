@@ -29,6 +29,8 @@ const KNOWN_SAMPLERS: &[&str] = &[
     "orthogonal",
     "ldsampler",
 ];
+/// Mitsuba 3's other reconstruction filters: mltbench warns and uses box.
+const OTHER_FILTERS: &[&str] = &["tent", "mitchell", "catmullrom", "lanczos"];
 /// Largest accepted film side, in pixels.
 const MAX_FILM_SIDE: i64 = 1 << 16;
 /// The 35 mm film a `focal_length` refers to, in millimetres.
@@ -245,7 +247,7 @@ impl Builder<'_> {
                 }
                 FilterDesc::Gaussian { stddev }
             }
-            other => {
+            other if OTHER_FILTERS.contains(&other) => {
                 props.ignore_all();
                 let w = tree.warning(
                     elem,
@@ -253,6 +255,15 @@ impl Builder<'_> {
                 );
                 self.desc.warnings.push(w);
                 FilterDesc::Box
+            }
+            other => {
+                return Err(tree.error(
+                    elem,
+                    format!(
+                        "unknown reconstruction filter type \"{other}\" (Mitsuba 3 has box, \
+                         gaussian, tent, mitchell, catmullrom and lanczos)"
+                    ),
+                ));
             }
         };
         props.finish()?;

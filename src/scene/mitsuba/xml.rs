@@ -41,6 +41,8 @@ pub(super) struct Tree {
     aliases: HashMap<String, (String, ElemId)>,
     /// `<path>` folders, searched first, the most recently declared first.
     pub path_folders: Vec<PathBuf>,
+    /// Remarks about the files read (e.g. a scene version newer than Mitsuba 3).
+    pub warnings: Vec<String>,
 }
 
 /// What an element is, which decides where it may appear.
@@ -290,6 +292,7 @@ pub(super) fn parse_scene_with(
             ids: HashMap::new(),
             aliases: HashMap::new(),
             path_folders: Vec::new(),
+            warnings: Vec::new(),
         },
         defaults: overrides.to_vec(),
         declared: Vec::new(),
@@ -315,7 +318,11 @@ pub(super) fn parse_scene_with(
                 "missing attribute \"version\" in <scene>",
             ));
         }
-        Some((_, version)) => check_version(version, root_location)?,
+        Some((_, version)) => {
+            if let Some(w) = check_version(version, root_location)? {
+                reader.tree.warnings.push(w);
+            }
+        }
     }
     reader.tree.elems.push(Elem {
         tag: "scene".into(),
@@ -354,7 +361,8 @@ fn parse_xml<'a>(text: &'a str, path: &Path) -> Result<roxmltree::Document<'a>> 
 }
 
 /// `version="major.minor.patch"`; scenes older than Mitsuba 2 use other parameter names.
-fn check_version(version: &str, location: impl Fn() -> Location) -> Result<()> {
+/// A version newer than Mitsuba 3 loads (Mitsuba 3 reads it without a word) with a warning.
+fn check_version(version: &str, location: impl Fn() -> Location) -> Result<Option<String>> {
     let parts: Vec<&str> = version.trim().split('.').collect();
     let numbers: Option<Vec<u32>> = parts.iter().map(|p| p.parse().ok()).collect();
     match numbers {
@@ -367,8 +375,14 @@ fn check_version(version: &str, location: impl Fn() -> Location) -> Result<()> {
                          names): convert it to Mitsuba 3 first"
                     ),
                 ))
+            } else if n[0] > 3 {
+                Ok(Some(format!(
+                    "{}: scene version {version} is newer than the Mitsuba 3 format mltbench \
+                     reads: parameters may have changed meaning",
+                    location()
+                )))
             } else {
-                Ok(())
+                Ok(None)
             }
         }
         _ => Err(Error::input(
@@ -521,6 +535,17 @@ impl Reader {
             return Err(Error::input(
                 location(),
                 format!("elements nested deeper than {MAX_ELEMENT_DEPTH} levels"),
+            ));
+        }
+        if tag == "spectrum"
+            && let Some((_, plugin)) = attrs.iter().find(|(k, _)| k == "type")
+        {
+            return Err(Error::input(
+                location(),
+                format!(
+                    "spectrum plugins (type=\"{plugin}\") are not supported yet: give the \
+                     spectrum as a value (\"400:0.5, 700:0.8\") or an <rgb>"
+                ),
             ));
         }
         check_attributes(&attrs, &tag, kind, location)?;
@@ -694,8 +719,10 @@ impl Reader {
             let attrs = self.substituted_attrs(&root, &path, line)?;
             let root_location = || Location::at(&path, line, "<scene>");
             check_attributes(&attrs, "scene", Kind::Scene, root_location)?;
-            if let Some((_, version)) = attrs.iter().find(|(k, _)| k == "version") {
-                check_version(version, root_location)?;
+            if let Some((_, version)) = attrs.iter().find(|(k, _)| k == "version")
+                && let Some(w) = check_version(version, root_location)?
+            {
+                self.tree.warnings.push(w);
             }
             self.expand_children(&doc, root, new_file, parent, parent_kind)?;
         } else {
