@@ -2,6 +2,10 @@
 
 use crate::math::Rgb;
 
+/// The most pixels an image may have, read (OpenEXR) or rendered (a scene's film):
+/// 2^28, e.g. 16384 × 16384, 3 GiB as f32 RGB.
+pub const MAX_PIXELS: u64 = 1 << 28;
+
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
     pub width: u32,

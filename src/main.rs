@@ -197,15 +197,9 @@ fn run_render(args: RenderArgs) -> Result<()> {
     let scene_params = parse_defines(&args.common.define)?;
     let description = mitsuba::load_file_with(&args.common.scene, &scene_params)?;
     io::outputs::check_not_inputs([output.as_path(), &preview], &description.files_read)?;
+    // Degenerate triangles are among these, once per mesh with its line.
     for warning in &description.warnings {
         eprintln!("warning: {warning}");
-    }
-    if description.skipped_triangles > 0 {
-        eprintln!(
-            "warning: {}: skipped {} degenerate triangles",
-            args.common.scene.display(),
-            description.skipped_triangles
-        );
     }
     let scene = Scene::build(description)?;
     let budget = match (args.spp, args.time) {

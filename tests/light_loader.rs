@@ -292,3 +292,76 @@ fn bad_envmaps_are_errors_naming_the_line() {
     assert_names(&message, &dir.join("scene.xml"), 3);
     assert!(message.contains("only area emitters"), "{message}");
 }
+
+/// Building the lights reads the image; its errors name the EXR and the `<emitter>`'s line.
+#[test]
+fn envmap_image_errors_name_the_scene_line_and_the_image() {
+    let dir = scratch("envmap_image_errors");
+    let mut image = Image::new(4, 3);
+    for j in 0..3 {
+        for i in 0..4 {
+            image.set(i, j, Rgb::splat(0.5));
+        }
+    }
+    image.set(2, 1, Rgb::new(0.5, f32::NAN, 0.5));
+    write_exr(&dir.join("nan.exr"), &image).unwrap();
+    std::fs::write(dir.join("garbage.exr"), b"not an image").unwrap();
+    for (name, what) in [("nan.exr", "texel (2, 1)"), ("garbage.exr", "OpenEXR")] {
+        let text = with_sphere(&format!(
+            "<emitter type=\"envmap\">\n<string name=\"filename\" value=\"{name}\"/></emitter>"
+        ));
+        let desc = load_written(&dir, &text).unwrap();
+        let message = LightSet::build(&desc).unwrap_err().to_string();
+        assert_names(&message, &dir.join("scene.xml"), line_of(&text, "envmap"));
+        assert!(
+            message.contains(name) && message.contains(what),
+            "{message}"
+        );
+    }
+}
+
+/// An area emitter whose shape has no area in f32 is an error at the emitter's line, for
+/// spheres, disks and meshes alike.
+#[test]
+fn emitters_of_zero_area_are_errors() {
+    let emitter = "\n<emitter type=\"area\"/>";
+    for (shape, when) in [
+        (
+            format!(
+                "<shape type=\"sphere\"><float name=\"radius\" value=\"1e-40\"/>{emitter}</shape>"
+            ),
+            "build",
+        ),
+        (
+            format!(
+                "<shape type=\"disk\"><transform name=\"to_world\"><scale x=\"1e-20\" y=\"1e-20\" z=\"1e30\"/></transform>{emitter}</shape>"
+            ),
+            "build",
+        ),
+        (
+            format!(
+                "<shape type=\"rectangle\"><transform name=\"to_world\"><scale x=\"1e-25\" y=\"1e-25\" z=\"1e30\"/></transform>{emitter}</shape>"
+            ),
+            "load",
+        ),
+    ] {
+        let text = with_sphere(&shape);
+        let line = line_of(&text, "<emitter");
+        let dir = scratch("zero_area");
+        let message = match (load_written(&dir, &text), when) {
+            (Ok(desc), "build") => LightSet::build(&desc).unwrap_err().to_string(),
+            (Err(e), "load") => e.to_string(),
+            (other, _) => panic!("{when}: {:?}\n{text}", other.map(|_| ())),
+        };
+        assert_names(&message, &dir.join("scene.xml"), line);
+        assert!(message.contains("emit"), "{message}");
+    }
+    // Small but representable: builds.
+    let desc = load_ok(
+        "small_area",
+        &with_sphere(
+            "<shape type=\"sphere\"><float name=\"radius\" value=\"1e-10\"/><emitter type=\"area\"/></shape>",
+        ),
+    );
+    LightSet::build(&desc).unwrap();
+}

@@ -1505,6 +1505,83 @@ fn envmap_files_are_read_and_checked() {
     assert!(err.contains(&missing.display().to_string()), "{err}");
 }
 
+/// Texels near f32's limit: a texel whose product with `scale` overflows is an error
+/// naming it; a finite texel of 3·10³⁸ is sampled by its true share (its cells' four-corner
+/// sums overflow f32), every other cell stays drawable, and the power stays finite.
+#[test]
+fn envmap_texels_near_the_f32_limit() {
+    let (w, h, mut t) = test_texels();
+    let sphere = SceneSphere {
+        center: Vec3::ZERO,
+        radius: 2.0,
+    };
+    let build = |t: &[Rgb], scale: f32| {
+        EnvmapLight::from_texels(
+            &PathBuf::from("hot.exr"),
+            w,
+            h,
+            t,
+            scale,
+            &Transform::IDENTITY,
+            sphere,
+        )
+    };
+    t[2 * w + 5] = Rgb::splat(1e30);
+    let err = build(&t, 1e10).unwrap_err().to_string();
+    assert!(
+        err.contains("hot.exr") && err.contains("texel (5, 2)") && err.contains("scale"),
+        "{err}"
+    );
+    assert!(build(&t, 1e8).is_ok());
+
+    t[2 * w + 5] = Rgb::splat(3e38);
+    let env = build(&t, 1.0).unwrap();
+    assert!(env.power().is_finite() && env.power() > 0.0);
+    let rows = h - 1;
+    let cos_row = |j: usize| (PI * j as f64 / rows as f64).cos();
+    let weight = |i: usize, j: usize| {
+        let i1 = (i + 1) % w;
+        let corners = [
+            t[j * w + i],
+            t[j * w + i1],
+            t[(j + 1) * w + i],
+            t[(j + 1) * w + i1],
+        ];
+        corners.iter().map(|&c| lum(c)).sum::<f64>() / 4.0 * (cos_row(j) - cos_row(j + 1))
+    };
+    let total: f64 = (0..rows)
+        .flat_map(|j| (0..w).map(move |i| (i, j)))
+        .map(|(i, j)| weight(i, j))
+        .sum();
+    for j in 0..rows {
+        for i in 0..w {
+            // The centre of cell (i, j), in the map's frame (identity here).
+            let phi = 2.0 * PI * (i as f64 + 1.0) / w as f64;
+            let cos = 0.5 * (cos_row(j) + cos_row(j + 1));
+            let sin = (1.0 - cos * cos).sqrt();
+            let d = Vec3::new(
+                (phi.sin() * sin) as f32,
+                cos as f32,
+                (-phi.cos() * sin) as f32,
+            );
+            let solid_angle = 2.0 * PI / w as f64 * (cos_row(j) - cos_row(j + 1));
+            let expect = weight(i, j) / total / solid_angle;
+            let pdf = env.pdf_direction(d) as f64;
+            if weight(i, j) > 0.0 {
+                assert!(pdf > 0.0, "cell ({i}, {j}) cannot be drawn");
+            }
+            if expect > 1e-30 {
+                assert!(
+                    (pdf - expect).abs() <= 1e-4 * expect,
+                    "cell ({i}, {j}): pdf {pdf}, expected {expect}"
+                );
+            }
+        }
+    }
+    let s = env.sample_li(Vec2::new(0.5, 0.5)).expect("a sample");
+    assert!(s.pdf_solid_angle.is_finite() && s.radiance.is_valid_radiance());
+}
+
 /// A black map is no light: nothing sampled, zero density and power.
 #[test]
 fn black_envmap_is_harmless() {

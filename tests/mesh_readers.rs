@@ -255,6 +255,24 @@ fn obj_keeps_normals_and_uvs_only_when_every_vertex_has_them() {
 }
 
 #[test]
+fn obj_reads_x_y_z_and_ignores_further_vertex_values() {
+    // As Mitsuba 3.9.1 does (measured): a `w` does not divide the position, vertex colours
+    // are ignored, a third texture coordinate too.
+    let dir = temp_dir("obj-extra-values");
+    let obj = "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 2\nvt 0.5 0.5 0.7\nvt 0.5 0.5\nvt 0.5 0.2 0.1\nf 1/1 2/2 3/3\n";
+    let mesh = read_obj(&write(&dir, "extra.obj", obj.as_bytes())).unwrap();
+    assert_eq!(mesh.positions, vec![Vec3::ZERO, Vec3::X, Vec3::Y]);
+    assert_eq!(
+        mesh.uvs,
+        Some(vec![
+            Vec2::new(0.5, 0.5),
+            Vec2::new(0.5, 0.5),
+            Vec2::new(0.5, 0.2)
+        ])
+    );
+}
+
+#[test]
 fn empty_obj_is_an_empty_mesh() {
     let dir = temp_dir("empty");
     let mesh = read_obj(&write(&dir, "empty.obj", b"# nothing\n")).unwrap();
@@ -296,6 +314,43 @@ fn missing_files_are_io_errors_naming_the_file() {
 }
 
 #[test]
+fn readers_refuse_directories_and_fifos_without_opening_them() {
+    let dir = temp_dir("not-files");
+    let fifo = dir.join("pipe.ply");
+    let has_fifo = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .is_ok_and(|s| s.success());
+    let mut inputs = vec![(dir.clone(), "is a directory")];
+    if has_fifo {
+        inputs.push((fifo, "not a regular file"));
+    }
+    for (path, what) in inputs {
+        // On another thread: a reader that opened the FIFO would block forever.
+        let (send, receive) = std::sync::mpsc::channel();
+        let p = path.clone();
+        std::thread::spawn(move || {
+            let errors = [
+                read_ply(&p).err().map(|e| e.to_string()),
+                read_obj(&p).err().map(|e| e.to_string()),
+                mltbench::io::exr::read_exr(&p).err().map(|e| e.to_string()),
+            ];
+            send.send(errors)
+        });
+        let errors = receive
+            .recv_timeout(std::time::Duration::from_secs(20))
+            .expect("a reader blocked");
+        for error in errors {
+            let error = error.expect("an error");
+            assert!(
+                error.contains(&path.display().to_string()) && error.contains(what),
+                "{error}"
+            );
+        }
+    }
+}
+
+#[test]
 fn ply_errors_name_the_file_and_the_record() {
     let dir = temp_dir("ply-errors");
     let text = ascii_ply();
@@ -310,6 +365,20 @@ fn ply_errors_name_the_file_and_the_record() {
         text.replace("ascii 1.0", "utf16 1.0").as_bytes(),
     );
     assert!(e.contains("unknown PLY format"), "{e}");
+    // 1.0 is the only version, and nothing may follow it.
+    for format in [
+        "ascii 7.5 junk",
+        "ascii 1.0 junk",
+        "ascii",
+        "binary_little_endian 2.0",
+    ] {
+        let e = ply_error(
+            &dir,
+            "version.ply",
+            text.replace("ascii 1.0", format).as_bytes(),
+        );
+        assert!(e.contains(":2:") && e.contains("1.0"), "{e}");
+    }
     ply_error(
         &dir,
         "no_end.ply",
@@ -329,7 +398,48 @@ fn ply_errors_name_the_file_and_the_record() {
     assert!(e.contains("face") || e.contains("too short"), "{e}");
     let cut = &text[..text.find("0.75").unwrap()];
     let e = ply_error(&dir, "cut_ascii.ply", cut.as_bytes());
-    assert!(e.contains("ends early") || e.contains("too short"), "{e}");
+    assert!(
+        e.contains(":27: vertex 4 has 10 values, expected 12"),
+        "{e}"
+    );
+    let cut = &text[..text.find("18 3").unwrap()];
+    let e = ply_error(&dir, "cut_ascii_line.ply", cut.as_bytes());
+    assert!(e.contains(":30: face 1") && e.contains("ends early"), "{e}");
+
+    // Ascii records are lines: too few or too many values on one is an error naming it,
+    // counting list lengths as written.
+    let line_of = |needle: &str| 1 + text.lines().position(|l| l.starts_with(needle)).unwrap();
+    let second_vertex = text.lines().nth(23).unwrap().to_string();
+    for (name, from, to, message) in [
+        (
+            "short_vertex.ply",
+            second_vertex.as_str(),
+            "0 1",
+            "vertex 1 has 2 values, expected at least 10",
+        ),
+        (
+            "long_vertex.ply",
+            second_vertex.as_str(),
+            &format!("{second_vertex} 7") as &str,
+            "vertex 1 has 13 values, expected 12",
+        ),
+        (
+            "short_face.ply",
+            "17 4 0 1 2 3 0.5",
+            "17 4 0 1 2",
+            "face 0 has 5 values, expected 7",
+        ),
+        (
+            "long_face.ply",
+            "18 3 1 4 2 0.25",
+            "18 3 1 4 2 0 0.25",
+            "face 1 has 7 values, expected 6",
+        ),
+    ] {
+        let e = ply_error(&dir, name, text.replacen(from, to, 1).as_bytes());
+        let line = line_of(from);
+        assert!(e.contains(&format!("{name}:{line}: {message}")), "{e}");
+    }
 
     // Counts that do not match the data: one vertex too many declared, one too few.
     ply_error(
@@ -343,7 +453,10 @@ fn ply_errors_name_the_file_and_the_record() {
         "fewer.ply",
         text.replace("element face 2", "element face 1").as_bytes(),
     );
-    assert!(e.contains("follow the last element"), "{e}");
+    assert!(
+        e.contains(":30:") && e.contains("follow the last element"),
+        "{e}"
+    );
     // A header count far beyond the file size is rejected before anything is allocated.
     let e = ply_error(
         &dir,
@@ -460,7 +573,35 @@ fn obj_errors_name_the_file_and_the_face() {
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 0 0\nf 1//1 2//1 3//1\n",
     );
     assert!(e.contains("zero length"), "{e}");
-    obj_error(&dir, "bad_v.obj", "v 0 0\nf 1 1 1\n");
+    assert!(e.contains(":4:"), "{e}");
+    // Vertex records: too few numbers or words that are not numbers, with the line.
+    for (name, text, line, what) in [
+        ("bad_v.obj", "v 0 0\nf 1 1 1\n", 1, "3 numbers"),
+        (
+            "word_v.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 abc\nf 1 2 3\n",
+            3,
+            "`abc`",
+        ),
+        (
+            "short_vt.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0.5\nf 1/1 2/1 3/1\n",
+            4,
+            "2 numbers",
+        ),
+        (
+            "short_vn.obj",
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\n\nvn 0 0\nf 1//1 2//1 3//1\n",
+            5,
+            "3 numbers",
+        ),
+    ] {
+        let e = obj_error(&dir, name, text);
+        assert!(
+            e.contains(&format!("{name}:{line}:")) && e.contains(what),
+            "{e}"
+        );
+    }
     let path = write(&dir, "latin1.obj", b"v 0 0 0 \xff\n");
     error_text(read_obj(&path), &path);
 }

@@ -388,6 +388,53 @@ fn floor_under_a_point_light_follows_the_inverse_square_law() {
 }
 
 #[test]
+fn depth_parameters_are_bounded_as_in_the_scene() {
+    // <integrator> refuses rr_depth 0 and max_depth below -1; so does --set.
+    let scene = furnace("sphere", "0.5", "1", -1, "");
+    for bad in ["rr_depth=0", "max_depth=-2"] {
+        let params = Params::parse(&[bad]).unwrap();
+        let error = estimator::create("pt", &params, &scene, 1)
+            .err()
+            .unwrap_or_else(|| panic!("{bad} accepted"))
+            .to_string();
+        assert!(error.contains(bad), "{error}");
+    }
+}
+
+#[test]
+fn a_tiny_sphere_light_is_a_point_light() {
+    // A sphere of radius r and radiance L has intensity I = π r² L in every direction. At
+    // r = 1e-10 its sampling densities (~1e20) square beyond f32: the MIS weight must hold.
+    let (rho, intensity, light) = (0.5f64, 4.0f64, Vec3::new(0.3, 0.5, -0.2));
+    let radius = 1e-10f64;
+    let radiance = intensity / (std::f64::consts::PI * radius * radius);
+    let scene = scene(&format!(
+        r#"<scene version="3.0.0">
+            {floor_camera}
+            <shape type="sphere"><point name="center" x="0.3" y="0.5" z="-0.2"/>
+                <float name="radius" value="{radius:e}"/>
+                <emitter type="area"><rgb name="radiance" value="{radiance:e}"/></emitter></shape>
+            {floor}
+        </scene>"#,
+        floor_camera = floor_camera(),
+        floor = floor(0.5)
+    ));
+    let image = render_pt(&scene, &[], 4, 9);
+    for (x, y) in [(8, 8), (2, 3), (14, 12)] {
+        let expected = floor_pixel_average(&scene, x, y, |p| {
+            let d = light - p;
+            intensity * (d.y / d.length()) as f64 / d.length_squared() as f64
+        }) * rho
+            / std::f64::consts::PI;
+        let v = image.get(x, y)[0] as f64;
+        assert!(
+            (v / expected - 1.0).abs() < 0.01,
+            "pixel ({x},{y}) = {v}, expected {expected}"
+        );
+    }
+}
+
+#[test]
 fn uniform_environment_lights_a_convex_diffuse_object_to_its_albedo() {
     // A convex object never sees itself: under a constant environment L its radiance is
     // a·L for any depth ≥ 2. A glass sphere alone under the same sky is invisible.

@@ -428,3 +428,39 @@ fn cli_compare_names_its_files() {
         );
     }
 }
+
+#[test]
+fn cli_prints_each_warning_once() {
+    // A mesh with a degenerate triangle: one warning naming the shape's line, not a second
+    // summary of the same triangles.
+    let dir = temp_dir("cli_warnings");
+    std::fs::write(
+        dir.join("mesh.obj"),
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 2 0 0\nf 1 2 3\nf 1 2 4\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("scene.xml"),
+        "<scene version=\"3.0.0\">\n<shape type=\"obj\"><string name=\"filename\" value=\"mesh.obj\"/></shape>\n\
+         <sensor type=\"perspective\"><film type=\"hdrfilm\"><integer name=\"width\" value=\"4\"/>\
+         <integer name=\"height\" value=\"4\"/></film></sensor>\n<emitter type=\"constant\"/>\n</scene>\n",
+    )
+    .unwrap();
+    let out = mltbench(
+        &[
+            "render",
+            "scene.xml",
+            "-e",
+            "eyelight",
+            "--spp",
+            "1",
+            "-o",
+            "out.exr",
+        ],
+        &dir,
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert_eq!(stderr.matches("degenerate").count(), 1, "{stderr}");
+    assert!(stderr.contains("scene.xml:2"), "{stderr}");
+}

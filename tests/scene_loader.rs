@@ -506,6 +506,17 @@ fn other_filters_warn_and_use_box() {
         warning.contains(&format!("scene.xml:{}", line_of(&text, "tent"))),
         "{warning}"
     );
+    // Not a Mitsuba filter at all: an error, like an unknown BSDF or shape type.
+    let text = with_sphere(
+        r#"<sensor type="perspective"><film type="hdrfilm">
+<rfilter type="bogus"/>
+</film></sensor>"#,
+    );
+    let message = load_err_at("bogus_filter", &text, line_of(&text, "bogus"));
+    assert!(
+        message.contains("unknown reconstruction filter"),
+        "{message}"
+    );
 }
 
 #[test]
@@ -1151,6 +1162,53 @@ fn zero_roughness_is_raised_with_a_warning() {
     assert!(desc.warnings.iter().any(|w| w.contains("roughness")));
 }
 
+#[test]
+fn roughness_is_bounded_above() {
+    // Above 1: loads with a warning; above 100 (a black surface, surely a typo): an error.
+    for kind in ["roughconductor", "roughdielectric", "roughplastic", "ward"] {
+        let desc = load_ok(
+            "alpha_large",
+            &scene(&format!(
+                "<shape type=\"sphere\"><bsdf type=\"{kind}\">\n<float name=\"alpha\" value=\"2\"/></bsdf></shape>"
+            )),
+        );
+        assert!(
+            desc.warnings
+                .iter()
+                .any(|w| w.contains("roughness 2") && w.contains("scene.xml:3")),
+            "{kind}: {:?}",
+            desc.warnings
+        );
+        for value in ["1e30", "101"] {
+            let message = load_err_at(
+                "alpha_huge",
+                &scene(&format!(
+                    "<shape type=\"sphere\"><bsdf type=\"{kind}\">\n<float name=\"alpha\" value=\"{value}\"/></bsdf></shape>"
+                )),
+                3,
+            );
+            assert!(message.contains("roughness"), "{message}");
+        }
+    }
+    let message = load_err_at(
+        "alpha_v_huge",
+        &scene(
+            "<shape type=\"sphere\"><bsdf type=\"roughconductor\"><float name=\"alpha_u\" value=\"0.1\"/>\n<float name=\"alpha_v\" value=\"1e30\"/></bsdf></shape>",
+        ),
+        3,
+    );
+    assert!(
+        message.contains("alpha") || message.contains("roughness"),
+        "{message}"
+    );
+    load_ok(
+        "alpha_100",
+        &scene(
+            r#"<shape type="sphere"><bsdf type="roughconductor"><float name="alpha" value="100"/></bsdf></shape>"#,
+        ),
+    );
+}
+
 // ---------------------------------------------------------------------------------------
 // Shapes
 
@@ -1592,6 +1650,135 @@ fn meaningless_negative_or_zero_values() {
 }
 
 #[test]
+fn reflectances_and_transmittances_above_one_are_errors() {
+    // Every reflectance-like parameter of every BSDF, in every way of writing a colour.
+    let params: &[(&str, &[&str])] = &[
+        ("diffuse", &["reflectance"]),
+        ("conductor", &["specular_reflectance"]),
+        ("roughconductor", &["specular_reflectance"]),
+        (
+            "dielectric",
+            &["specular_reflectance", "specular_transmittance"],
+        ),
+        (
+            "thindielectric",
+            &["specular_reflectance", "specular_transmittance"],
+        ),
+        (
+            "roughdielectric",
+            &["specular_reflectance", "specular_transmittance"],
+        ),
+        ("plastic", &["diffuse_reflectance", "specular_reflectance"]),
+        (
+            "roughplastic",
+            &["diffuse_reflectance", "specular_reflectance"],
+        ),
+        ("phong", &["diffuse_reflectance", "specular_reflectance"]),
+        ("blinn", &["diffuse_reflectance", "specular_reflectance"]),
+        ("ward", &["diffuse_reflectance", "specular_reflectance"]),
+    ];
+    let values = [
+        "<rgb name=\"NAME\" value=\"5\"/>",
+        "<rgb name=\"NAME\" value=\"0.5, 1.0001, 0.5\"/>",
+        "<float name=\"NAME\" value=\"1.5\"/>",
+        "<integer name=\"NAME\" value=\"2\"/>",
+        "<spectrum name=\"NAME\" value=\"5\"/>",
+        "<spectrum name=\"NAME\" value=\"400:5, 700:5\"/>",
+        "<spectrum name=\"NAME\" value=\"400:0.5, 550:-0.1, 700:0.5\"/>",
+    ];
+    for (bsdf, names) in params {
+        for name in *names {
+            for value in values {
+                let body = format!(
+                    "<shape type=\"sphere\"><bsdf type=\"{bsdf}\">\n{}</bsdf></shape>",
+                    value.replace("NAME", name)
+                );
+                let (message, file) = load_err("reflectance_range", &scene(&body));
+                assert_names(&message, &file, 3);
+                assert!(message.contains("[0, 1]"), "{message}");
+            }
+        }
+    }
+    // Radiance, eta, k and alpha are not bounded by 1.
+    bsdf_of(
+        r#"<bsdf type="roughconductor"><rgb name="eta" value="2"/><rgb name="k" value="5"/>
+           <float name="alpha" value="0.9"/></bsdf><emitter type="area"><rgb name="radiance" value="5"/></emitter>"#,
+        "unbounded",
+    );
+    // A spectrum inside [0, 1] whose RGB leaves the gamut is clamped as Mitsuba 3.9.1 does
+    // (measured: [1, 0.089609, 1]), with a warning naming the line.
+    let text = scene(
+        "<shape type=\"sphere\"><bsdf type=\"diffuse\">\n\
+         <spectrum name=\"reflectance\" value=\"360:1, 480:1, 500:0, 560:0, 580:1, 830:1\"/>\
+         </bsdf></shape>",
+    );
+    let desc = load_ok("out_of_gamut", &text);
+    let BsdfDesc::Diffuse { reflectance } = desc.bsdfs[0] else {
+        panic!("{:?}", desc.bsdfs)
+    };
+    assert_eq!((reflectance.0[0], reflectance.0[2]), (1.0, 1.0));
+    assert!(
+        (reflectance.0[1] - 0.089609).abs() < 1e-5,
+        "{reflectance:?}"
+    );
+    let warning = desc
+        .warnings
+        .iter()
+        .find(|w| w.contains("clamped"))
+        .expect("a clamping warning");
+    assert!(warning.contains("scene.xml:3"), "{warning}");
+    // The glossy extensions' two lobes must not add up to more than 1.
+    let text = scene(
+        "<shape type=\"sphere\"><bsdf type=\"phong\"><rgb name=\"diffuse_reflectance\" value=\"0.6\"/>\n\
+         <rgb name=\"specular_reflectance\" value=\"0.2, 0.5, 0.2\"/></bsdf></shape>",
+    );
+    let message = load_err_at("phong_sum", &text, 3);
+    assert!(message.contains("more light than it receives"), "{message}");
+}
+
+#[test]
+fn films_with_too_many_pixels_are_errors() {
+    // Each side within its own bound, the product not: an error at the side written last,
+    // also when the sides come from `-D` parameters.
+    let text = with_sphere(
+        r#"<default name="res" value="16384"/>
+<sensor type="perspective"><film type="hdrfilm">
+<integer name="width" value="$res"/>
+<integer name="height" value="$res"/>
+</film></sensor>"#,
+    );
+    let dir = scratch("huge_film");
+    let path = write(&dir, "scene.xml", &text);
+    let desc = load_file(&path).expect("16384² is the largest film");
+    assert_eq!(
+        (desc.sensor.film.width, desc.sensor.film.height),
+        (16384, 16384)
+    );
+    for res in ["16385", "20000", "65536"] {
+        let params = [("res".to_string(), res.to_string())];
+        let message = mltbench::scene::mitsuba::load_file_with(&path, &params)
+            .unwrap_err()
+            .to_string();
+        assert_names(&message, &path, line_of(&text, "\"height\""));
+        assert!(message.contains("pixels"), "{message}");
+        assert!(message.contains(&format!("width at line {}", line_of(&text, "\"width\""))));
+    }
+    // A default side counts too: 65536 × 576 is fine, 65536 × 8192 is not.
+    let one_side = |extra: &str| {
+        with_sphere(&format!(
+            "<sensor type=\"perspective\"><film type=\"hdrfilm\">\n\
+             <integer name=\"width\" value=\"65536\"/>{extra}</film></sensor>"
+        ))
+    };
+    load_ok("wide_film", &one_side(""));
+    let (message, file) = load_err(
+        "wide_tall_film",
+        &one_side("\n<integer name=\"height\" value=\"8192\"/>"),
+    );
+    assert_names(&message, &file, 5);
+}
+
+#[test]
 fn dangling_ref() {
     let text = scene("<shape type=\"sphere\">\n<ref id=\"nowhere\"/></shape>");
     let (message, file) = load_err("dangling", &text);
@@ -1655,6 +1842,42 @@ fn root_and_version_are_checked() {
         "<scene version=\"0.6.0\"><shape type=\"sphere\"/></scene>",
     );
     assert!(message.contains("0.6.0"), "{message}");
+    // Newer than Mitsuba 3: loads (Mitsuba 3.9.1 says nothing) with a warning, also when it
+    // is an included file that is newer.
+    let desc = load_ok(
+        "new_version",
+        "<scene version=\"4.0.0\"><shape type=\"sphere\"/></scene>",
+    );
+    assert!(
+        desc.warnings
+            .iter()
+            .any(|w| w.contains("4.0.0") && w.contains("scene.xml:1")),
+        "{:?}",
+        desc.warnings
+    );
+    let dir = scratch("new_version_include");
+    write(
+        &dir,
+        "part.xml",
+        "<scene version=\"5.1.0\"><shape type=\"sphere\"/></scene>",
+    );
+    let desc = load_written(&dir, &scene("<include filename=\"part.xml\"/>")).unwrap();
+    assert!(
+        desc.warnings
+            .iter()
+            .any(|w| w.contains("5.1.0") && w.contains("part.xml:1")),
+        "{:?}",
+        desc.warnings
+    );
+    let desc = load_ok(
+        "current_version",
+        "<scene version=\"3.9.1\"><shape type=\"sphere\"/></scene>",
+    );
+    assert!(
+        !desc.warnings.iter().any(|w| w.contains("newer")),
+        "{:?}",
+        desc.warnings
+    );
 }
 
 #[test]
@@ -1711,6 +1934,10 @@ fn unsupported_features_say_so() {
             "<shape type=\"rectangle\"><medium type=\"homogeneous\" name=\"interior\"/></shape>",
             "<medium type=\"homogeneous\" name=\"interior\">",
         ),
+        (
+            "<shape type=\"sphere\"><emitter type=\"area\"><spectrum type=\"blackbody\" name=\"radiance\"><float name=\"temperature\" value=\"5000\"/></spectrum></emitter></shape>",
+            "<spectrum type=\"blackbody\" name=\"radiance\">",
+        ),
     ] {
         let message = load_err_at("unsupported", &with_sphere(body), 3);
         assert!(message.contains("not supported yet"), "{message}");
@@ -1748,6 +1975,66 @@ fn missing_files_are_named() {
     let text = with_sphere("<path value=\"no_such_folder\"/>");
     let message = load_written(&dir, &text).unwrap_err().to_string();
     assert_names(&message, &dir.join("scene.xml"), 3);
+}
+
+/// Runs `load` on another thread: a read that blocks (a FIFO) fails the test instead of
+/// hanging it.
+fn within_seconds<T: Send + 'static>(load: impl FnOnce() -> T + Send + 'static) -> T {
+    let (send, receive) = std::sync::mpsc::channel();
+    std::thread::spawn(move || send.send(load()));
+    receive
+        .recv_timeout(std::time::Duration::from_secs(20))
+        .expect("the load blocked")
+}
+
+#[test]
+fn inputs_that_are_not_regular_files_are_errors() {
+    let dir = scratch("not_files");
+    std::fs::create_dir_all(dir.join("adir")).unwrap();
+    for (body, needle) in [
+        (
+            "<shape type=\"obj\">\n<string name=\"filename\" value=\"adir\"/></shape>",
+            "adir",
+        ),
+        ("<include filename=\"adir\"/>", "adir"),
+        (
+            "<emitter type=\"envmap\">\n<string name=\"filename\" value=\"adir\"/></emitter>",
+            "adir",
+        ),
+    ] {
+        let text = with_sphere(body);
+        let message = load_written(&dir, &text).unwrap_err().to_string();
+        assert_names(&message, &dir.join("scene.xml"), line_of(&text, needle));
+        assert!(message.contains("is a directory"), "{message}");
+    }
+    // A FIFO blocks whoever opens it for reading until someone writes: refused unopened,
+    // as the scene itself, a mesh, an include or an environment map.
+    let fifo = dir.join("pipe");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        eprintln!("mkfifo unavailable: FIFO cases skipped");
+        return;
+    }
+    let path = fifo.clone();
+    let message = within_seconds(move || load_file(&path).map(|_| ()))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("pipe") && message.contains("not a regular file"),
+        "{message}"
+    );
+    for body in [
+        "<shape type=\"ply\">\n<string name=\"filename\" value=\"pipe\"/></shape>",
+        "<include filename=\"pipe\"/>",
+        "<emitter type=\"envmap\">\n<string name=\"filename\" value=\"pipe\"/></emitter>",
+    ] {
+        let text = with_sphere(body);
+        let scene_dir = dir.clone();
+        let loaded = within_seconds(move || load_written(&scene_dir, &text).map(|_| ()));
+        let message = loaded.unwrap_err().to_string();
+        assert!(message.contains("not a regular file"), "{message}");
+        assert!(message.contains("scene.xml:"), "{message}");
+    }
 }
 
 #[test]

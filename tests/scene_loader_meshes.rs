@@ -164,15 +164,34 @@ fn degenerate_triangles_are_skipped_and_counted() {
             .iter()
             .any(|w| w.contains("2 degenerate") && w.contains("scene.xml:2"))
     );
+    let skipped: Vec<&String> = desc
+        .warnings
+        .iter()
+        .filter(|w| w.contains("shape skipped"))
+        .collect();
+    assert_eq!(skipped.len(), 1, "{:?}", desc.warnings);
     assert!(
-        desc.warnings
-            .iter()
-            .any(|w| w.contains("no triangles left") && w.contains("scene.xml:3"))
+        skipped[0].contains("all 1 triangles") && skipped[0].contains("scene.xml:3"),
+        "{}",
+        skipped[0]
     );
-    // Nothing else left: the scene is empty.
+    // Nothing else left: the scene is empty, and the error says why (warnings are printed
+    // only with a scene that loads).
     let text = scene(r#"<shape type="obj"><string name="filename" value="flat.obj"/></shape>"#);
     let message = load_written(&dir, &text).unwrap_err().to_string();
     assert!(message.contains("no shapes"), "{message}");
+    assert!(
+        message.contains("scene.xml:2") && message.contains("degenerate"),
+        "{message}"
+    );
+    // The same for a mesh file without faces.
+    write(&dir, "points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2\n");
+    let text = scene(r#"<shape type="obj"><string name="filename" value="points.obj"/></shape>"#);
+    let message = load_written(&dir, &text).unwrap_err().to_string();
+    assert!(
+        message.contains("scene.xml:2") && message.contains("no faces"),
+        "{message}"
+    );
 }
 
 #[test]

@@ -23,7 +23,7 @@ use glam::Vec3;
 
 use super::Params;
 use super::camera_pass::{CameraEstimator, CameraSampleFn};
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::geometry::{Ray, SurfaceInteraction};
 use crate::light::LightPoint;
 use crate::material::{Bsdf, TransportMode};
@@ -48,12 +48,14 @@ impl PtSettings {
         let integrator = &scene.description.integrator;
         let max_depth: i64 = params.get("max_depth", integrator.max_depth as i64)?;
         let rr_depth: u32 = params.get("rr_depth", integrator.rr_depth)?;
-        // As the scene file's `rr_depth` (and Mitsuba 3): roulette at the camera vertex
-        // itself is not a setting either accepts.
+        // The same bounds as the scene's <integrator> (Mitsuba's).
+        if max_depth < -1 {
+            return Err(Error::usage(format!(
+                "--set max_depth={max_depth}: must be -1 (unbounded) or at least 0"
+            )));
+        }
         if rr_depth == 0 {
-            return Err(crate::error::Error::usage(
-                "rr_depth must be greater than zero, got 0",
-            ));
+            return Err(Error::usage("--set rr_depth=0: must be at least 1"));
         }
         let max_depth = if max_depth < 0 {
             None

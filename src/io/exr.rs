@@ -14,7 +14,7 @@ use exr::prelude::{
 };
 
 use crate::error::{Error, Location, Result};
-use crate::image::Image;
+use crate::image::{Image, MAX_PIXELS};
 use crate::io::atomic::write_atomically;
 use crate::math::Rgb;
 
@@ -63,9 +63,6 @@ pub fn write_exr(path: &Path, image: &Image) -> Result<()> {
     })
 }
 
-/// The largest image `read_exr` accepts (2^28 pixels, 3 GiB as f32 RGB).
-const MAX_PIXELS: usize = 1 << 28;
-
 /// Reads the first RGB layer of an OpenEXR file as linear RGB, row 0 at the top.
 pub fn read_exr(path: &Path) -> Result<Image> {
     let read = exr::prelude::read()
@@ -90,12 +87,13 @@ pub fn read_exr(path: &Path) -> Result<Image> {
         .all_attributes()
         .non_parallel();
     // Check the sizes the header claims before anything is allocated for them.
+    crate::io::check_input_file(path)?;
     let file = std::fs::File::open(path).map_err(|e| Error::io(path, e))?;
     let meta = exr::meta::MetaData::read_from_buffered(std::io::BufReader::new(file), false)
         .map_err(|e| exr_error(path, "not a readable", e))?;
     for header in &meta.headers {
         let (w, h) = (header.layer_size.width(), header.layer_size.height());
-        if w.checked_mul(h).is_none_or(|n| n > MAX_PIXELS) {
+        if w.checked_mul(h).is_none_or(|n| n as u64 > MAX_PIXELS) {
             return Err(Error::input(
                 Location::file(path),
                 format!("OpenEXR layer of {w}×{h} pixels is larger than mltbench reads"),

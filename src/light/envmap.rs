@@ -45,7 +45,7 @@ pub struct EnvmapLight {
 
 impl EnvmapLight {
     /// Reads the image. Errors name the file: unreadable, smaller than 2 × 3, or a texel that
-    /// is negative or not finite.
+    /// is negative or not finite, or that overflows f32 times `scale`.
     pub fn load(
         filename: &Path,
         scale: f32,
@@ -102,7 +102,17 @@ impl EnvmapLight {
                 "the environment map's to_world is singular".to_string(),
             ));
         }
-        let texels: Vec<Rgb> = texels.iter().map(|&t| t * scale).collect();
+        let scaled: Vec<Rgb> = texels.iter().map(|&t| t * scale).collect();
+        if let Some(k) = scaled.iter().position(|t| !t.is_valid_radiance()) {
+            return Err(fail(format!(
+                "texel ({}, {}) of the environment map is {:?}: times the scale {scale} it \
+                 overflows f32",
+                k % width,
+                k / width,
+                texels[k].0
+            )));
+        }
+        let texels = scaled;
         let rows = height - 1;
         let cos_rows: Vec<f32> = (0..height)
             .map(|j| {
@@ -113,6 +123,7 @@ impl EnvmapLight {
                 }
             })
             .collect();
+        // Weights and flux in f64: four corners of 3e38 overflow an f32 sum.
         let mut weights = Vec::with_capacity(width * rows);
         let mut flux = 0.0f64; // ∫ L̄ dω by the cell rule
         for j in 0..rows {
@@ -125,15 +136,20 @@ impl EnvmapLight {
                     texels[(j + 1) * width + i],
                     texels[(j + 1) * width + i1],
                 ];
-                let lum: f32 = corners.iter().map(|c| c.luminance()).sum::<f32>() * 0.25;
-                let mean: f64 = corners.iter().map(|c| c.mean() as f64).sum::<f64>() * 0.25;
-                weights.push((lum as f64 * band) as f32);
+                let lum: f64 = corners.iter().map(luminance_f64).sum::<f64>() * 0.25;
+                let mean: f64 = corners
+                    .iter()
+                    .map(|c| c.0.iter().map(|&v| v as f64).sum::<f64>() / 3.0)
+                    .sum::<f64>()
+                    * 0.25;
+                weights.push(lum * band);
                 flux += mean * band * 2.0 * std::f64::consts::PI / width as f64;
             }
         }
-        let cells = Distribution2D::new(&weights, width, rows);
+        let cells = Distribution2D::new(&f32_weights(&weights), width, rows);
         let r = sphere.radius as f64;
-        let power = (std::f64::consts::PI * r * r * flux) as f32;
+        // Only compared with other lights' powers: saturate rather than become infinite.
+        let power = (std::f64::consts::PI * r * r * flux).min(f32::MAX as f64) as f32;
         Ok(EnvmapLight {
             filename: filename.to_path_buf(),
             width,
@@ -255,4 +271,31 @@ impl EnvmapLight {
     pub fn pdf_le(&self, dir: Vec3) -> (f32, f32) {
         (self.sphere.disk_pdf(), self.pdf_direction(-dir))
     }
+}
+
+fn luminance_f64(c: &Rgb) -> f64 {
+    0.2126 * c.0[0] as f64 + 0.7152 * c.0[1] as f64 + 0.0722 * c.0[2] as f64
+}
+
+/// The cells' weights as f32 for `Distribution2D`: scaled by a power of two (exact) when
+/// their sum would come near f32's range, and every positive weight kept positive, so each
+/// cell whose radiance is not zero stays drawable.
+fn f32_weights(weights: &[f64]) -> Vec<f32> {
+    const MAX_SUM: f64 = 1e30;
+    let sum: f64 = weights.iter().sum();
+    let factor = if sum > MAX_SUM {
+        2f64.powi(-((sum / MAX_SUM).log2().ceil() as i32))
+    } else {
+        1.0
+    };
+    weights
+        .iter()
+        .map(|&w| {
+            if w > 0.0 {
+                ((w * factor) as f32).max(f32::MIN_POSITIVE)
+            } else {
+                0.0
+            }
+        })
+        .collect()
 }

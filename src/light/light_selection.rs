@@ -15,11 +15,12 @@ pub struct LightSelection {
 }
 
 impl LightSelection {
-    /// From the lights' powers (negative or non-finite powers count as 0).
+    /// From the lights' powers (negative or NaN powers count as 0; a power that overflowed
+    /// f32 counts as f32::MAX, so that light is still chosen).
     pub fn new(powers: &[f32]) -> LightSelection {
         let weights: Vec<f32> = powers
             .iter()
-            .map(|&p| if p.is_finite() && p > 0.0 { p } else { 0.0 })
+            .map(|&p| if p > 0.0 { p.min(f32::MAX) } else { 0.0 })
             .collect();
         LightSelection {
             by_power: Distribution1D::new(&weights),
@@ -35,5 +36,18 @@ impl LightSelection {
     /// Probability of choosing light `i`.
     pub fn pmf(&self, i: usize) -> f32 {
         self.by_power.as_ref().map_or(0.0, |d| d.pmf(i))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_power_that_overflowed_is_still_chosen() {
+        let selection = LightSelection::new(&[f32::INFINITY, 1.0, f32::NAN, -1.0]);
+        assert!(selection.pmf(0) > 0.99);
+        assert!(selection.pmf(1) > 0.0);
+        assert_eq!((selection.pmf(2), selection.pmf(3)), (0.0, 0.0));
     }
 }

@@ -270,16 +270,17 @@ pub enum Light {
 }
 
 impl Light {
-    /// Builds the light `desc` describes. `sphere` bounds the scene (`SceneSphere::
-    /// from_shapes`). Errors (naming the scene file, and the shape or image file): an area
-    /// emitter on a shape with no area or a missing shape, an unreadable or invalid
-    /// environment map, a degenerate placement.
+    /// Builds the light `desc` describes, written at `location` in the scene. `sphere`
+    /// bounds the scene (`SceneSphere::from_shapes`). Errors (at `location`, naming the
+    /// shape or image file): an area emitter on a shape with no area or a missing shape, an
+    /// unreadable or invalid environment map, a degenerate placement.
     pub fn from_desc(
         desc: &EmitterDesc,
         scene: &SceneDescription,
         sphere: SceneSphere,
+        location: &Location,
     ) -> Result<Light> {
-        let fail = |message: String| Error::input(Location::file(&scene.source), message);
+        let fail = |message: String| Error::input(location.clone(), message);
         Ok(match desc {
             EmitterDesc::Area { radiance, shape } => {
                 let Some(shape_desc) = scene.shapes.get(*shape) else {
@@ -333,9 +334,11 @@ impl Light {
                 filename,
                 scale,
                 to_world,
-            } => Light::Envmap(Box::new(EnvmapLight::load(
-                filename, *scale, to_world, sphere,
-            )?)),
+            } => Light::Envmap(Box::new(
+                // The image's own message (naming the EXR) after the emitter's location.
+                EnvmapLight::load(filename, *scale, to_world, sphere)
+                    .map_err(|e| fail(e.to_string()))?,
+            )),
         })
     }
 
@@ -479,7 +482,7 @@ impl LightSet {
         let mut shape_lights = vec![None; scene.shapes.len()];
         let mut environment = Vec::new();
         for (i, desc) in scene.emitters.iter().enumerate() {
-            let light = Light::from_desc(desc, scene, sphere)?;
+            let light = Light::from_desc(desc, scene, sphere, &scene.emitter_location(i))?;
             if let Some(shape) = light.shape() {
                 shape_lights[shape] = Some(i);
             }

@@ -49,9 +49,9 @@ pub enum ShapeSampler {
 
 impl ShapeSampler {
     /// Err(reason) when the shape has no area that could emit (no valid triangle, radius
-    /// not positive, singular disk transform).
+    /// not positive, singular disk transform, an area that underflows f32).
     pub fn new(shape: &ShapeDesc) -> Result<ShapeSampler, String> {
-        match &shape.geometry {
+        let sampler = match &shape.geometry {
             ShapeGeometry::Mesh(mesh) => MeshSampler::new(mesh).map(ShapeSampler::Mesh),
             ShapeGeometry::Sphere { center, radius } => {
                 SphereSampler::new(*center, *radius, shape.flip_normals).map(ShapeSampler::Sphere)
@@ -59,7 +59,17 @@ impl ShapeSampler {
             ShapeGeometry::Disk { to_world } => {
                 DiskSampler::new(to_world, shape.flip_normals).map(ShapeSampler::Disk)
             }
+        }?;
+        // Points are drawn with density 1/A: it must be finite (a sphere of radius 1e-40 has
+        // A = 0 in f32, and would emit nothing).
+        let area = sampler.area();
+        if !area.is_normal() {
+            return Err(format!(
+                "its surface area is {area:e} in f32, too small to sample (the density 1/area \
+                 of its points is not finite)"
+            ));
         }
+        Ok(sampler)
     }
 
     /// Surface area.

@@ -5,6 +5,7 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::error::Location;
 use crate::math::{Rgb, Transform};
 
 /// Everything a scene file describes, in world space.
@@ -21,10 +22,24 @@ pub struct SceneDescription {
     pub bsdfs: Vec<BsdfDesc>,
     /// Area emitters point back at their shape; the others stand alone.
     pub emitters: Vec<EmitterDesc>,
+    /// Where each emitter was written (same indices as `emitters`; may be shorter for
+    /// descriptions made in code, see `emitter_location`).
+    pub emitter_locations: Vec<Location>,
     /// Degenerate (zero-area) triangles dropped while loading meshes.
     pub skipped_triangles: usize,
     /// Non-fatal remarks (e.g. "rfilter tent: using box"), each naming file and line.
     pub warnings: Vec<String>,
+}
+
+impl SceneDescription {
+    /// Where emitter `i` was written, for messages about it: its element in the scene, or
+    /// the scene file when the loader did not record one.
+    pub fn emitter_location(&self, i: usize) -> Location {
+        self.emitter_locations
+            .get(i)
+            .cloned()
+            .unwrap_or_else(|| Location::file(&self.source))
+    }
 }
 
 /// `<integrator>`: only the path-length settings matter; mltbench picks the estimator.

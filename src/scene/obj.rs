@@ -10,9 +10,11 @@
 //! Texture coordinates are returned as written in the file. Mitsuba 3 flips them by default
 //! (`v` → 1 − `v`, its `flip_tex_coords`), which is the scene loader's business.
 //!
-//! Before tobj parses the file, every face's indices are checked here against the numbers
-//! of `v`, `vt` and `vn` lines above it, so that a bad index gets a message with the line
-//! and the face, and so that tobj never sees an index it could mishandle.
+//! Before tobj parses the file, every `v`, `vt`, `vn` and `f` record is checked here, so
+//! that bad input gets a message with its line and tobj never sees a record it could reject
+//! or mishandle: vertex records need their numbers (x y z, u v, x y z; finite), and only
+//! those go on to tobj (any further values are ignored, as Mitsuba 3 ignores a `w` or a
+//! vertex colour); face indices must refer to records above them.
 
 use std::io::Cursor;
 use std::path::Path;
@@ -24,6 +26,7 @@ use crate::error::{Error, Location, Result};
 
 /// Reads every object of an OBJ file into one mesh in object space.
 pub fn read_obj(path: &Path) -> Result<TriangleMesh> {
+    crate::io::check_input_file(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let text = std::str::from_utf8(&bytes).map_err(|e| {
         Error::input(
@@ -34,17 +37,7 @@ pub fn read_obj(path: &Path) -> Result<TriangleMesh> {
             ),
         )
     })?;
-    check_faces(path, text)?;
-    // Only the geometry records go to tobj. Without `o`, `g` and `usemtl` it sees one object
-    // and keeps one vertex table for the whole file: a vertex is shared by every face that
-    // names the same (v, vt, vn) triple, wherever it is, as in Mitsuba 3 (this decides which
-    // faces a computed smooth normal averages over). It also never sees `l` records (which
-    // it would turn into polygons) nor material files.
-    let geometry: String = text
-        .lines()
-        .filter(|l| matches!(first_word(l), Some("v" | "vt" | "vn" | "f")))
-        .flat_map(|l| [l, "\n"])
-        .collect();
+    let geometry = geometry_records(path, text)?;
 
     let options = tobj::LoadOptions {
         single_index: true,
@@ -60,27 +53,58 @@ pub fn read_obj(path: &Path) -> Result<TriangleMesh> {
     merge_models(path, &models)
 }
 
-fn first_word(line: &str) -> Option<&str> {
-    line.split_whitespace().next()
-}
-
-/// Checks every `f` record's indices (1-based, or negative = relative to the end) against
-/// the `v`, `vt` and `vn` records before it, and that the values of those records are finite.
-fn check_faces(path: &Path, text: &str) -> Result<()> {
+/// The file's geometry records, checked, as tobj should read them. Only these go to tobj:
+/// without `o`, `g` and `usemtl` it sees one object and keeps one vertex table for the whole
+/// file, so a vertex is shared by every face that names the same (v, vt, vn) triple, as in
+/// Mitsuba 3 (this decides which faces a computed smooth normal averages over); it never
+/// sees `l` records (which it would turn into polygons) nor material files.
+///
+/// Face indices (1-based, or negative = relative to the end) are checked against the `v`,
+/// `vt` and `vn` records before them.
+fn geometry_records(path: &Path, text: &str) -> Result<String> {
     let (mut positions, mut texcoords, mut normals) = (0i64, 0i64, 0i64);
     let mut faces = 0u64;
+    let mut out = String::with_capacity(text.len());
     for (line_index, line) in text.lines().enumerate() {
+        let line_number = u32::try_from(line_index + 1).unwrap_or(u32::MAX);
         let mut words = line.split_whitespace();
         match words.next() {
             Some(keyword @ ("v" | "vt" | "vn")) => {
-                // Values that do not parse are left to tobj; parsed ones must be finite.
-                if words.any(|w| w.parse::<f32>().is_ok_and(|x| !x.is_finite())) {
-                    let line_number = u32::try_from(line_index + 1).unwrap_or(u32::MAX);
-                    return Err(Error::input(
-                        Location::at(path, line_number, keyword),
-                        "a value is not finite",
-                    ));
+                let (needed, what) = match keyword {
+                    "v" => (3, "a position needs 3 numbers (x y z)"),
+                    "vt" => (2, "a texture coordinate needs 2 numbers (u v)"),
+                    _ => (3, "a normal needs 3 numbers (x y z)"),
+                };
+                let record_error = |message: String| {
+                    let shown: String = line.trim().chars().take(40).collect();
+                    Error::input(
+                        Location::at(path, line_number, format!("`{shown}`")),
+                        message,
+                    )
+                };
+                let values: Vec<&str> = words.take(needed).collect();
+                if values.len() < needed {
+                    return Err(record_error(format!("{what}, got {}", values.len())));
                 }
+                let mut numbers = [0.0f32; 3];
+                for (number, value) in numbers.iter_mut().zip(&values) {
+                    *number = match value.parse::<f32>() {
+                        Ok(x) if x.is_finite() => x,
+                        Ok(_) => return Err(record_error(format!("`{value}` is not finite"))),
+                        Err(_) => {
+                            return Err(record_error(format!("`{value}` is not a number")));
+                        }
+                    };
+                }
+                if keyword == "vn" && Vec3::from(numbers).normalize_or_zero() == Vec3::ZERO {
+                    return Err(record_error("the normal has zero length".into()));
+                }
+                out.push_str(keyword);
+                for value in values {
+                    out.push(' ');
+                    out.push_str(value);
+                }
+                out.push('\n');
                 match keyword {
                     "v" => positions += 1,
                     "vt" => texcoords += 1,
@@ -88,7 +112,6 @@ fn check_faces(path: &Path, text: &str) -> Result<()> {
                 }
             }
             Some("f") => {
-                let line_number = u32::try_from(line_index + 1).unwrap_or(u32::MAX);
                 let face_error = |message: String| {
                     Error::input(
                         Location::at(path, line_number, format!("face {faces}")),
@@ -121,12 +144,14 @@ fn check_faces(path: &Path, text: &str) -> Result<()> {
                         return Err(face_error(format!("`{vertex}` is not a valid face vertex")));
                     }
                 }
+                out.push_str(line);
+                out.push('\n');
                 faces += 1;
             }
             _ => {}
         }
     }
-    Ok(())
+    Ok(out)
 }
 
 fn merge_models(path: &Path, models: &[tobj::Model]) -> Result<TriangleMesh> {

@@ -5,7 +5,9 @@
 //! else `s`/`t`, the order Mitsuba 3 looks for them), and the `face` element's `vertex_index`
 //! (else `vertex_indices`) list. Polygons are fan-triangulated (0,1,2), (0,2,3), …; faces with
 //! fewer than three vertices add no triangle. Every other element and property, lists included,
-//! is read over and ignored. Texture coordinates are returned as written (no flip).
+//! is read over and ignored. Texture coordinates are returned as written (no flip). An ascii
+//! body is read line by line, one record per line: a line with too few or too many values for
+//! its record is an error naming the line.
 //!
 //! Bad input never panics and never makes the reader allocate more than the file's size
 //! justifies: every count in the header is checked against the bytes that follow it.
@@ -19,6 +21,7 @@ use crate::error::{Error, Location, Result};
 
 /// Reads a PLY file into a mesh in object space.
 pub fn read_ply(path: &Path) -> Result<TriangleMesh> {
+    crate::io::check_input_file(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let header = parse_header(path, &bytes)?;
     let body = match header.format {
@@ -26,6 +29,9 @@ pub fn read_ply(path: &Path) -> Result<TriangleMesh> {
             data: &bytes,
             pos: header.body_start,
             line: header.body_line,
+            record_line: header.body_line,
+            tokens: Vec::new(),
+            next: 0,
         },
         Format::BinaryLittleEndian => Body::Binary {
             data: &bytes,
@@ -228,6 +234,17 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
                         ));
                     }
                 });
+                // 1.0 is the only version of the format there is.
+                if rest.get(1..) != Some(&["1.0"][..]) {
+                    return Err(header_error(
+                        line_number,
+                        format!(
+                            "expected `format {} 1.0`, got `format {}`",
+                            rest[0],
+                            rest.join(" ")
+                        ),
+                    ));
+                }
             }
             "element" => {
                 let [name, count] = rest[..] else {
@@ -325,12 +342,17 @@ fn parse_header(path: &Path, bytes: &[u8]) -> Result<Header> {
     })
 }
 
-/// The data after the header, read value by value.
+/// The data after the header, read value by value; ascii records one line each.
 enum Body<'a> {
     Ascii {
         data: &'a [u8],
+        /// Start of the first line not read yet, and its 1-based number.
         pos: usize,
         line: u32,
+        /// The current record's line, its values (byte ranges) and the next one to read.
+        record_line: u32,
+        tokens: Vec<(usize, usize)>,
+        next: usize,
     },
     Binary {
         data: &'a [u8],
@@ -338,6 +360,22 @@ enum Body<'a> {
         big_endian: bool,
     },
 }
+
+/// Why a value could not be read.
+enum ValueError {
+    /// An ascii record's line holds no more values.
+    EndOfLine,
+    Message(String),
+}
+
+impl From<String> for ValueError {
+    fn from(message: String) -> Self {
+        ValueError::Message(message)
+    }
+}
+
+const ENDS_EARLY: &str =
+    "the file ends early (truncated data or a count in the header that is too large)";
 
 impl Body<'_> {
     fn remaining(&self) -> usize {
@@ -348,7 +386,7 @@ impl Body<'_> {
 
     fn line(&self) -> Option<u32> {
         match *self {
-            Body::Ascii { line, .. } => Some(line),
+            Body::Ascii { record_line, .. } => Some(record_line),
             Body::Binary { .. } => None,
         }
     }
@@ -362,36 +400,106 @@ impl Body<'_> {
         }
     }
 
-    /// Reads one value as f64 (exact for every PLY type). Errors are plain messages; the
-    /// caller adds the location.
-    fn read(&mut self, ty: Scalar) -> std::result::Result<f64, String> {
+    /// Ascii: moves to the next line that holds values, the next record's. Binary: nothing.
+    fn begin_record(&mut self) -> std::result::Result<(), ValueError> {
+        let Body::Ascii {
+            data,
+            pos,
+            line,
+            record_line,
+            tokens,
+            next,
+        } = self
+        else {
+            return Ok(());
+        };
+        tokens.clear();
+        *next = 0;
+        while tokens.is_empty() {
+            *record_line = *line;
+            if *pos >= data.len() {
+                return Err(ENDS_EARLY.to_string().into());
+            }
+            let end = data[*pos..]
+                .iter()
+                .position(|&b| b == b'\n')
+                .map_or(data.len(), |i| *pos + i);
+            let mut i = *pos;
+            while i < end {
+                if data[i].is_ascii_whitespace() {
+                    i += 1;
+                    continue;
+                }
+                let start = i;
+                while i < end && !data[i].is_ascii_whitespace() {
+                    i += 1;
+                }
+                tokens.push((start, i));
+            }
+            *pos = (end + 1).min(data.len());
+            *line += 1;
+        }
+        Ok(())
+    }
+
+    /// Ascii: (values on the record's line, values read) when the line holds more values
+    /// than the record took.
+    fn extra_values(&self) -> Option<(usize, usize)> {
         match self {
-            Body::Ascii { data, pos, line } => {
-                while *pos < data.len() && data[*pos].is_ascii_whitespace() {
-                    if data[*pos] == b'\n' {
-                        *line += 1;
+            Body::Ascii { tokens, next, .. } if *next < tokens.len() => Some((tokens.len(), *next)),
+            _ => None,
+        }
+    }
+
+    /// Ascii: the number of values a record of `element` on the current line needs, from
+    /// the list lengths written there; the flag is false when a missing list length makes
+    /// it a lower bound. Also the number of values on the line.
+    fn expected_values(&self, element: &Element) -> (usize, bool, usize) {
+        let Body::Ascii { data, tokens, .. } = self else {
+            return (0, true, 0);
+        };
+        let token = |i: usize| {
+            tokens
+                .get(i)
+                .and_then(|&(s, e)| std::str::from_utf8(&data[s..e]).ok())
+        };
+        let (mut at, mut total, mut exact) = (0usize, 0usize, true);
+        for property in &element.properties {
+            total += 1;
+            if let PropertyKind::List { .. } = property.kind {
+                match token(at).and_then(|t| t.parse::<usize>().ok()) {
+                    Some(n) => {
+                        total = total.saturating_add(n);
+                        at = at.saturating_add(n);
                     }
-                    *pos += 1;
+                    None => exact = false,
                 }
-                if *pos >= data.len() {
-                    return Err(
-                        "the file ends early (truncated data or a count in the header \
-                                that is too large)"
-                            .into(),
-                    );
-                }
-                let start = *pos;
-                while *pos < data.len() && !data[*pos].is_ascii_whitespace() {
-                    *pos += 1;
-                }
-                let token = std::str::from_utf8(&data[start..*pos]).unwrap_or("");
+            }
+            at = at.saturating_add(1);
+        }
+        (total, exact, tokens.len())
+    }
+
+    /// Reads one value as f64 (exact for every PLY type). The caller adds the location.
+    fn read(&mut self, ty: Scalar) -> std::result::Result<f64, ValueError> {
+        match self {
+            Body::Ascii {
+                data, tokens, next, ..
+            } => {
+                let Some(&(start, end)) = tokens.get(*next) else {
+                    return Err(ValueError::EndOfLine);
+                };
+                *next += 1;
+                let token = std::str::from_utf8(&data[start..end]).unwrap_or("");
                 let value: f64 = token
                     .parse()
                     .map_err(|_| format!("`{}` is not a number", token.escape_debug()))?;
                 if ty.is_integer() {
                     let (lo, hi) = ty.integer_range();
                     if value.fract() != 0.0 || value < lo || value > hi {
-                        return Err(format!("`{token}` is not a valid `{}` value", ty.name()));
+                        return Err(
+                            format!("`{token}` is not a valid `{}` value", ty.name()).into()
+                        );
                     }
                 }
                 Ok(value)
@@ -403,11 +511,7 @@ impl Body<'_> {
             } => {
                 let size = ty.size();
                 if data.len() - *pos < size {
-                    return Err(
-                        "the file ends early (truncated data or a count in the header \
-                                that is too large)"
-                            .into(),
-                    );
+                    return Err(ENDS_EARLY.to_string().into());
                 }
                 let mut raw = [0u8; 8];
                 raw[..size].copy_from_slice(&data[*pos..*pos + size]);
@@ -430,18 +534,30 @@ impl Body<'_> {
         }
     }
 
-    /// Reads a list's length and checks that the rest of the file can hold it.
-    fn read_list_len(&mut self, count: Scalar, item: Scalar) -> std::result::Result<usize, String> {
+    /// Reads a list's length and checks that the rest of the file (ascii: of the line) can
+    /// hold it.
+    fn read_list_len(
+        &mut self,
+        count: Scalar,
+        item: Scalar,
+    ) -> std::result::Result<usize, ValueError> {
         let n = self.read(count)?;
         if n < 0.0 {
-            return Err(format!("negative list length {n}"));
+            return Err(format!("negative list length {n}").into());
         }
         let n = n as usize;
+        if let Body::Ascii { tokens, next, .. } = self {
+            return if n > tokens.len() - *next {
+                Err(ValueError::EndOfLine)
+            } else {
+                Ok(n)
+            };
+        }
         let min_item = self.min_size(PropertyKind::Scalar(item));
         if n.saturating_mul(min_item) > self.remaining() {
-            return Err(format!(
-                "a list of {n} values does not fit in the rest of the file"
-            ));
+            return Err(
+                format!("a list of {n} values does not fit in the rest of the file").into(),
+            );
         }
         Ok(n)
     }
@@ -461,6 +577,39 @@ struct VertexLayout {
 
 impl MeshReader<'_> {
     /// An error about record `index` of an element ("vertex 3", "face 12", counted from 0).
+    /// The error for a value of record `index` of `element` that could not be read.
+    fn value_error(&self, element: &Element, index: u64, e: ValueError) -> Error {
+        match e {
+            ValueError::Message(message) => self.error(&element.name, index, message),
+            ValueError::EndOfLine => {
+                let (expected, exact, got) = self.body.expected_values(element);
+                let at_least = if exact { "" } else { "at least " };
+                self.record_count_error(element, index, got, &format!("{at_least}{expected}"))
+            }
+        }
+    }
+
+    /// "FILE:LINE: vertex 3 has 2 values, expected 3" (ascii only).
+    fn record_count_error(
+        &self,
+        element: &Element,
+        index: u64,
+        got: usize,
+        expected: &str,
+    ) -> Error {
+        Error::input(
+            Location {
+                file: self.path.to_path_buf(),
+                line: self.body.line(),
+                element: None,
+            },
+            format!(
+                "{} {index} has {got} values, expected {expected}",
+                element.name
+            ),
+        )
+    }
+
     fn error(&self, element: &str, index: u64, message: impl Into<String>) -> Error {
         let what = format!("{element} {index}");
         let location = match self.body.line() {
@@ -561,13 +710,18 @@ impl MeshReader<'_> {
 
             for record in 0..element.count {
                 values.clear();
+                if !element.properties.is_empty() {
+                    self.body
+                        .begin_record()
+                        .map_err(|e| self.value_error(element, record, e))?;
+                }
                 for (k, property) in element.properties.iter().enumerate() {
                     match property.kind {
                         PropertyKind::Scalar(ty) => {
                             let v = self
                                 .body
                                 .read(ty)
-                                .map_err(|m| self.error(&element.name, record, m))?;
+                                .map_err(|e| self.value_error(element, record, e))?;
                             values.push(v);
                         }
                         PropertyKind::List { count, item } => {
@@ -575,7 +729,7 @@ impl MeshReader<'_> {
                             let n = self
                                 .body
                                 .read_list_len(count, item)
-                                .map_err(|m| self.error(&element.name, record, m))?;
+                                .map_err(|e| self.value_error(element, record, e))?;
                             let keep = is_face && face_list == Some(k);
                             if keep {
                                 polygon.clear();
@@ -584,7 +738,7 @@ impl MeshReader<'_> {
                                 let v = self
                                     .body
                                     .read(item)
-                                    .map_err(|m| self.error(&element.name, record, m))?;
+                                    .map_err(|e| self.value_error(element, record, e))?;
                                 if keep {
                                     if v.fract() != 0.0 || v < 0.0 || v >= vertex_count as f64 {
                                         return Err(self.error(
@@ -601,6 +755,14 @@ impl MeshReader<'_> {
                             }
                         }
                     }
+                }
+                if let Some((got, expected)) = self.body.extra_values() {
+                    return Err(self.record_count_error(
+                        element,
+                        record,
+                        got,
+                        &expected.to_string(),
+                    ));
                 }
                 if is_vertex {
                     self.add_vertex(&mut mesh, &layout, &values, record)?;
@@ -658,28 +820,37 @@ impl MeshReader<'_> {
     /// After the last element only whitespace may follow (ascii), or at most a line ending
     /// (binary): anything else means the header's counts do not match the data.
     fn check_end(&self) -> Result<()> {
-        let (data, pos, binary) = match self.body {
-            Body::Ascii { data, pos, .. } => (data, pos, false),
-            Body::Binary { data, pos, .. } => (data, pos, true),
+        let (data, pos, line) = match self.body {
+            Body::Ascii {
+                data, pos, line, ..
+            } => (data, pos, Some(line)),
+            Body::Binary { data, pos, .. } => (data, pos, None),
         };
         let rest = &data[pos..];
-        let clean = if binary {
-            rest.is_empty() || rest == b"\n" || rest == b"\r\n"
-        } else {
-            rest.iter().all(|b| b.is_ascii_whitespace())
+        let stray = match line {
+            None => !(rest.is_empty() || rest == b"\n" || rest == b"\r\n"),
+            Some(_) => rest.iter().any(|b| !b.is_ascii_whitespace()),
         };
-        if clean {
-            Ok(())
-        } else {
-            Err(Error::input(
-                Location::file(self.path),
-                format!(
-                    "{} bytes of data follow the last element: the header's counts do not match \
-                     the data",
-                    rest.len()
-                ),
-            ))
+        if !stray {
+            return Ok(());
         }
+        // Ascii: the line of the first value after the last record.
+        let line = line.map(|line| {
+            let blank = rest.iter().take_while(|b| b.is_ascii_whitespace());
+            line + blank.filter(|&&b| b == b'\n').count() as u32
+        });
+        Err(Error::input(
+            Location {
+                file: self.path.to_path_buf(),
+                line,
+                element: None,
+            },
+            format!(
+                "{} bytes of data follow the last element: the header's counts do not match \
+                 the data",
+                rest.len()
+            ),
+        ))
     }
 }
 

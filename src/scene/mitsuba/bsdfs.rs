@@ -16,11 +16,11 @@
 //!   specular_reflectance 0.2.
 
 use super::Builder;
-use super::values::{Props, Value};
+use super::values::{Props, SpectrumValue, Value};
 use super::xml::ElemId;
 use crate::error::Result;
 use crate::math::Rgb;
-use crate::scene::spectra::{named_conductor, named_ior};
+use crate::scene::spectra::{SpectrumUse, named_conductor, named_ior, spectrum_to_rgb};
 use crate::scene::{BsdfDesc, IorPair, MicrofacetKind, Roughness};
 
 /// Named IORs used as defaults (the values of Mitsuba's IOR table).
@@ -29,6 +29,11 @@ const IOR_AIR: f32 = 1.000277;
 const IOR_POLYPROPYLENE: f32 = 1.49;
 /// Smallest microfacet roughness Mitsuba accepts.
 const MIN_ALPHA: f32 = 1e-4;
+/// Largest roughness mltbench accepts. α is the microfacets' RMS slope: Mitsuba calls 0.3–0.7
+/// extremely rough, and as α grows the microfacet models reflect less and less (at α = 100 a
+/// rough conductor sphere returns under 10⁻⁶ of the light, in Mitsuba 3.9.1 as here). A
+/// larger value is a typo, not a material; above 1 mltbench warns.
+const MAX_ALPHA: f32 = 100.0;
 
 /// Mitsuba BSDF plugins mltbench does not implement (a clearer message than "unknown").
 const UNSUPPORTED: &[&str] = &[
@@ -89,11 +94,11 @@ impl Builder<'_> {
         let props = Props::collect(tree, elem)?;
         let desc = match kind {
             "diffuse" => BsdfDesc::Diffuse {
-                reflectance: reflectance(&props, "reflectance", 0.5)?,
+                reflectance: self.reflectance(&props, "reflectance", 0.5)?,
             },
             "conductor" => {
                 let eta_k = conductor_ior(&props)?;
-                let specular_reflectance = reflectance(&props, "specular_reflectance", 1.0)?;
+                let specular_reflectance = self.reflectance(&props, "specular_reflectance", 1.0)?;
                 BsdfDesc::Conductor {
                     eta_k,
                     specular_reflectance,
@@ -101,7 +106,7 @@ impl Builder<'_> {
             }
             "roughconductor" => {
                 let eta_k = conductor_ior(&props)?;
-                let specular_reflectance = reflectance(&props, "specular_reflectance", 1.0)?;
+                let specular_reflectance = self.reflectance(&props, "specular_reflectance", 1.0)?;
                 let roughness = self.roughness(&props, true)?;
                 BsdfDesc::RoughConductor {
                     eta_k,
@@ -111,8 +116,9 @@ impl Builder<'_> {
             }
             "dielectric" | "thindielectric" | "roughdielectric" => {
                 let ior = ior_pair(&props, IOR_BK7, false)?;
-                let specular_reflectance = reflectance(&props, "specular_reflectance", 1.0)?;
-                let specular_transmittance = reflectance(&props, "specular_transmittance", 1.0)?;
+                let specular_reflectance = self.reflectance(&props, "specular_reflectance", 1.0)?;
+                let specular_transmittance =
+                    self.reflectance(&props, "specular_transmittance", 1.0)?;
                 match kind {
                     "dielectric" => BsdfDesc::Dielectric {
                         ior,
@@ -134,8 +140,8 @@ impl Builder<'_> {
             }
             "plastic" | "roughplastic" => {
                 let ior = ior_pair(&props, IOR_POLYPROPYLENE, true)?;
-                let diffuse_reflectance = reflectance(&props, "diffuse_reflectance", 0.5)?;
-                let specular_reflectance = reflectance(&props, "specular_reflectance", 1.0)?;
+                let diffuse_reflectance = self.reflectance(&props, "diffuse_reflectance", 0.5)?;
+                let specular_reflectance = self.reflectance(&props, "specular_reflectance", 1.0)?;
                 let nonlinear = props.boolean("nonlinear")?.unwrap_or(false);
                 if kind == "plastic" {
                     BsdfDesc::Plastic {
@@ -164,8 +170,9 @@ impl Builder<'_> {
                         format!("exponent must be positive, got {exponent}"),
                     ));
                 }
-                let diffuse_reflectance = reflectance(&props, "diffuse_reflectance", 0.5)?;
-                let specular_reflectance = reflectance(&props, "specular_reflectance", 0.2)?;
+                let diffuse_reflectance = self.reflectance(&props, "diffuse_reflectance", 0.5)?;
+                let specular_reflectance = self.reflectance(&props, "specular_reflectance", 0.2)?;
+                energy_conserving(&props, diffuse_reflectance, specular_reflectance)?;
                 if kind == "phong" {
                     BsdfDesc::Phong {
                         exponent,
@@ -182,8 +189,9 @@ impl Builder<'_> {
             }
             "ward" => {
                 let (alpha_u, alpha_v) = self.alphas(&props)?;
-                let diffuse_reflectance = reflectance(&props, "diffuse_reflectance", 0.5)?;
-                let specular_reflectance = reflectance(&props, "specular_reflectance", 0.2)?;
+                let diffuse_reflectance = self.reflectance(&props, "diffuse_reflectance", 0.5)?;
+                let specular_reflectance = self.reflectance(&props, "specular_reflectance", 0.2)?;
+                energy_conserving(&props, diffuse_reflectance, specular_reflectance)?;
                 BsdfDesc::Ward {
                     alpha_u,
                     alpha_v,
@@ -245,6 +253,52 @@ impl Builder<'_> {
                 Ok(BsdfDesc::TwoSided { front, back })
             }
         }
+    }
+
+    /// A reflectance or transmittance: each channel in [0, 1] however it is written
+    /// (Mitsuba 3 refuses only an `<rgb>` outside; it renders a `<float>` of 5 as it is and
+    /// clamps a spectrum's RGB). A spectrum's samples must lie in [0, 1]; its RGB, when out of
+    /// gamut, is clamped as Mitsuba does, with a warning.
+    fn reflectance(&mut self, props: &Props, name: &str, default: f32) -> Result<Rgb> {
+        let Some(rgb) = props.color(name)? else {
+            return Ok(Rgb::splat(default));
+        };
+        let prop = props.get(name).expect("color() found the parameter");
+        let outside = |v: f32| !(0.0..=1.0).contains(&v);
+        let bad = match &prop.value {
+            Value::Spectrum(SpectrumValue::Pairs(pairs)) => pairs
+                .iter()
+                .find(|(_, v)| outside(*v))
+                .map(|(w, v)| format!("{v} at {w} nm")),
+            Value::Spectrum(SpectrumValue::Constant(v)) => outside(*v).then(|| v.to_string()),
+            _ => rgb
+                .0
+                .iter()
+                .any(|&c| outside(c))
+                .then(|| format!("{:?}", rgb.0)),
+        };
+        if let Some(value) = bad {
+            return Err(props_error(
+                props,
+                name,
+                format!("{name} must lie in [0, 1] (a reflectance or transmittance), got {value}"),
+            ));
+        }
+        if let Value::Spectrum(SpectrumValue::Pairs(pairs)) = &prop.value {
+            let unclamped = spectrum_to_rgb(pairs, SpectrumUse::Unbounded);
+            if unclamped != rgb {
+                let w = self.tree.warning(
+                    prop.elem,
+                    &format!(
+                        "{name} converts to RGB {:?}, outside [0, 1]: clamped to {:?}, as \
+                         Mitsuba 3 does",
+                        unclamped.0, rgb.0
+                    ),
+                );
+                self.desc.warnings.push(w);
+            }
+        }
+        Ok(rgb)
     }
 
     /// `distribution`, `alpha` / `alpha_u` + `alpha_v`, `sample_visible`.
@@ -310,6 +364,25 @@ impl Builder<'_> {
                     format!("roughness must not be negative, got {alpha}"),
                 ));
             }
+            if alpha > MAX_ALPHA {
+                return Err(tree.error(
+                    props.elem_of(name),
+                    format!(
+                        "roughness {alpha} is above {MAX_ALPHA}: the surface would be black \
+                         (α is the microfacets' RMS slope; 0.3–0.7 is already extremely rough)"
+                    ),
+                ));
+            }
+            if alpha > 1.0 {
+                let w = tree.warning(
+                    props.elem_of(name),
+                    &format!(
+                        "roughness {alpha} is above 1 (0.3–0.7 is already extremely rough): \
+                         the surface darkens as α grows"
+                    ),
+                );
+                self.desc.warnings.push(w);
+            }
             if alpha < MIN_ALPHA {
                 let w = tree.warning(
                     props.elem_of(name),
@@ -335,19 +408,27 @@ impl Builder<'_> {
     }
 }
 
-/// A reflectance-like colour: finite and not negative.
-fn reflectance(props: &Props, name: &str, default: f32) -> Result<Rgb> {
-    let Some(rgb) = props.color(name)? else {
-        return Ok(Rgb::splat(default));
-    };
-    if !rgb.0.iter().all(|c| *c >= 0.0) {
+/// `phong`, `blinn`, `ward`: their lobes are normalised so that the albedo stays at most
+/// ρ_d + ρ_s, which must therefore not exceed 1 in any channel.
+fn energy_conserving(props: &Props, diffuse: Rgb, specular: Rgb) -> Result<()> {
+    let sum = diffuse + specular;
+    if sum.0.iter().any(|&c| c > 1.0) {
+        let at = if props.has("specular_reflectance") {
+            "specular_reflectance"
+        } else {
+            "diffuse_reflectance"
+        };
         return Err(props_error(
             props,
-            name,
-            format!("{name} must not be negative, got {rgb:?}"),
+            at,
+            format!(
+                "diffuse_reflectance + specular_reflectance is {:?}: above 1 the surface \
+                 reflects more light than it receives",
+                sum.0
+            ),
         ));
     }
-    Ok(rgb)
+    Ok(())
 }
 
 fn props_error(props: &Props, name: &str, message: String) -> crate::error::Error {

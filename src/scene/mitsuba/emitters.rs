@@ -99,6 +99,7 @@ impl Builder<'_> {
         };
         props.finish()?;
         self.desc.emitters.push(desc);
+        self.desc.emitter_locations.push(tree.location(elem));
         Ok(true)
     }
 }

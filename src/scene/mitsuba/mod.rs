@@ -74,6 +74,8 @@ pub(super) struct Builder<'a> {
     environment: Option<ElemId>,
     /// Objects being parsed right now: a reference back to one of them is a cycle.
     in_progress: HashSet<ElemId>,
+    /// Why each skipped shape was skipped (also among the warnings).
+    skipped_shapes: Vec<String>,
 }
 
 impl<'a> Builder<'a> {
@@ -81,6 +83,7 @@ impl<'a> Builder<'a> {
         let desc = SceneDescription {
             source: path.to_path_buf(),
             files_read: tree.files.clone(),
+            warnings: tree.warnings.clone(),
             ..SceneDescription::default()
         };
         Builder {
@@ -92,6 +95,7 @@ impl<'a> Builder<'a> {
             attached_emitters: HashMap::new(),
             environment: None,
             in_progress: HashSet::new(),
+            skipped_shapes: Vec::new(),
         }
     }
 
@@ -176,9 +180,15 @@ impl<'a> Builder<'a> {
             }
         }
         if self.desc.shapes.is_empty() {
+            // Warnings are printed only with a scene: say here why shapes were skipped.
+            let why = if self.skipped_shapes.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", self.skipped_shapes.join("; "))
+            };
             return Err(Error::input(
                 Location::file(tree.file_of(tree.root)),
-                "scene has no shapes",
+                format!("scene has no shapes{why}"),
             ));
         }
         if integrator.is_none() {

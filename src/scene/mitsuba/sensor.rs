@@ -7,6 +7,7 @@ use super::Builder;
 use super::values::Props;
 use super::xml::ElemId;
 use crate::error::Result;
+use crate::image::MAX_PIXELS;
 use crate::math::Transform;
 use crate::scene::{FilmDesc, FilterDesc, FovAxis, SensorDesc, ThinLensDesc};
 
@@ -28,6 +29,8 @@ const KNOWN_SAMPLERS: &[&str] = &[
     "orthogonal",
     "ldsampler",
 ];
+/// Mitsuba 3's other reconstruction filters: mltbench warns and uses box.
+const OTHER_FILTERS: &[&str] = &["tent", "mitchell", "catmullrom", "lanczos"];
 /// Largest accepted film side, in pixels.
 const MAX_FILM_SIDE: i64 = 1 << 16;
 /// The 35 mm film a `focal_length` refers to, in millimetres.
@@ -175,6 +178,32 @@ impl Builder<'_> {
                 *side = v as u32;
             }
         }
+        // Each side is bounded above, their product here: a 65536² film would ask for
+        // hundreds of GiB of accumulators and abort the process.
+        let pixels = u64::from(film.width) * u64::from(film.height);
+        if pixels > MAX_PIXELS {
+            // Name the side written last (the other may be a default), and both lines.
+            let at = ["height", "width"]
+                .into_iter()
+                .filter(|name| props.has(name))
+                .max_by_key(|name| tree.elem(props.elem_of(name)).line)
+                .map_or(elem, |name| props.elem_of(name));
+            let lines: Vec<String> = ["width", "height"]
+                .into_iter()
+                .filter(|name| props.has(name))
+                .map(|name| format!("{name} at line {}", tree.elem(props.elem_of(name)).line))
+                .collect();
+            return Err(tree.error(
+                at,
+                format!(
+                    "a film of {} × {} = {pixels} pixels ({}) is larger than mltbench renders \
+                     (at most {MAX_PIXELS} pixels, e.g. 16384 × 16384)",
+                    film.width,
+                    film.height,
+                    lines.join(", ")
+                ),
+            ));
+        }
         // Output format settings do not change the radiance mltbench computes.
         props.ignore(&[
             "file_format",
@@ -218,7 +247,7 @@ impl Builder<'_> {
                 }
                 FilterDesc::Gaussian { stddev }
             }
-            other => {
+            other if OTHER_FILTERS.contains(&other) => {
                 props.ignore_all();
                 let w = tree.warning(
                     elem,
@@ -226,6 +255,15 @@ impl Builder<'_> {
                 );
                 self.desc.warnings.push(w);
                 FilterDesc::Box
+            }
+            other => {
+                return Err(tree.error(
+                    elem,
+                    format!(
+                        "unknown reconstruction filter type \"{other}\" (Mitsuba 3 has box, \
+                         gaussian, tent, mitchell, catmullrom and lanczos)"
+                    ),
+                ));
             }
         };
         props.finish()?;

@@ -29,6 +29,9 @@ const UNSUPPORTED: &[&str] = &[
     "merge",
 ];
 
+/// A shape's world-space geometry, or why it has none (a mesh without triangles).
+type Placed = std::result::Result<ShapeGeometry, String>;
+
 impl Builder<'_> {
     pub(super) fn parse_shape(&mut self, elem: ElemId) -> Result<()> {
         let tree = self.tree;
@@ -66,7 +69,7 @@ impl Builder<'_> {
                 };
                 self.placed_mesh(elem, mesh, &placement)?
             }
-            "disk" => Some(ShapeGeometry::Disk { to_world }),
+            "disk" => Ok(ShapeGeometry::Disk { to_world }),
             _ => {
                 let center = props.vector("center")?.unwrap_or(Vec3::ZERO);
                 let radius = props.float("radius")?.unwrap_or(1.0);
@@ -78,7 +81,7 @@ impl Builder<'_> {
                 }
                 let (center, radius) = sphere(&to_world, center, radius)
                     .map_err(|message| tree.error(props.elem_of("to_world"), message))?;
-                Some(ShapeGeometry::Sphere { center, radius })
+                Ok(ShapeGeometry::Sphere { center, radius })
             }
         };
 
@@ -146,10 +149,20 @@ impl Builder<'_> {
         }
         props.finish()?;
 
-        let Some(geometry) = geometry else {
-            let w = tree.warning(elem, "the mesh has no triangles left: shape skipped");
-            self.desc.warnings.push(w);
-            return Ok(());
+        let geometry = match geometry {
+            Ok(geometry) => geometry,
+            Err(why) => {
+                if let Some((emitter_elem, _)) = emitter {
+                    return Err(tree.error(
+                        emitter_elem,
+                        format!("this area emitter cannot emit: {why}"),
+                    ));
+                }
+                let w = tree.warning(elem, &format!("{why}: shape skipped"));
+                self.desc.warnings.push(w.clone());
+                self.skipped_shapes.push(w);
+                return Ok(());
+            }
         };
         let bsdf = match bsdf {
             Some(index) => index,
@@ -162,6 +175,9 @@ impl Builder<'_> {
                 radiance,
                 shape: index,
             });
+            self.desc
+                .emitter_locations
+                .push(tree.location(emitter_elem));
             self.desc.emitters.len() - 1
         });
         let name = match tree.attr(elem, "id") {
@@ -191,7 +207,7 @@ impl Builder<'_> {
         kind: &str,
         to_world: Transform,
         flip_normals: bool,
-    ) -> Result<Option<ShapeGeometry>> {
+    ) -> Result<Placed> {
         let tree = self.tree;
         let owner = props.owner();
         let Some(filename) = props.string("filename")? else {
@@ -224,16 +240,26 @@ impl Builder<'_> {
         self.placed_mesh(owner, mesh, &placement)
     }
 
-    /// Places an object-space mesh; None when no triangle survives.
+    /// Places an object-space mesh; Err(why) when no triangle survives.
     fn placed_mesh(
         &mut self,
         elem: ElemId,
         mesh: TriangleMesh,
         placement: &Placement,
-    ) -> Result<Option<ShapeGeometry>> {
+    ) -> Result<Placed> {
+        let faces = mesh.indices.len();
         let (mesh, skipped) = place_mesh(mesh, placement)
             .map_err(|problem| self.tree.error(elem, problem.to_string()))?;
         self.desc.skipped_triangles += skipped;
+        if mesh.indices.is_empty() {
+            return Ok(Err(if faces == 0 {
+                "the mesh has no faces (points or lines are not read)".to_string()
+            } else {
+                format!(
+                    "all {faces} triangles of the mesh are degenerate (zero-area or non-finite)"
+                )
+            }));
+        }
         if skipped > 0 {
             let w = self.tree.warning(
                 elem,
@@ -241,7 +267,7 @@ impl Builder<'_> {
             );
             self.desc.warnings.push(w);
         }
-        Ok((!mesh.indices.is_empty()).then_some(ShapeGeometry::Mesh(mesh)))
+        Ok(Ok(ShapeGeometry::Mesh(mesh)))
     }
 
     fn note_file(&mut self, path: PathBuf) {

@@ -41,6 +41,8 @@ pub(super) struct Tree {
     aliases: HashMap<String, (String, ElemId)>,
     /// `<path>` folders, searched first, the most recently declared first.
     pub path_folders: Vec<PathBuf>,
+    /// Remarks about the files read (e.g. a scene version newer than Mitsuba 3).
+    pub warnings: Vec<String>,
 }
 
 /// What an element is, which decides where it may appear.
@@ -177,7 +179,8 @@ impl Tree {
     }
 
     /// `resolve_file`, or the message for a file that does not exist:
-    /// `{what} "{name}" not found (searched: …)`, every place looked at listed.
+    /// `{what} "{name}" not found (searched: …)`, every place looked at listed; or, when
+    /// the name exists but is no regular file, what it is.
     pub fn find_file(
         &self,
         name: &str,
@@ -186,6 +189,12 @@ impl Tree {
     ) -> std::result::Result<PathBuf, String> {
         let (found, searched) = self.resolve_file(name, named_in);
         found.ok_or_else(|| {
+            for path in &searched {
+                if let Ok(meta) = std::fs::metadata(path) {
+                    let why = crate::io::not_a_file(&meta);
+                    return format!("{what} \"{name}\" {why} ({})", path.display());
+                }
+            }
             let list: Vec<String> = searched.iter().map(|p| p.display().to_string()).collect();
             format!(
                 "{what} \"{name}\" not found (searched: {})",
@@ -226,6 +235,7 @@ fn parent_dir(file: &Path) -> &Path {
 
 /// Reads a file as scene text: it must be UTF-8 without NUL bytes.
 pub(super) fn read_text(path: &Path) -> Result<String> {
+    crate::io::check_input_file(path)?;
     let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let line_at =
         |offset: usize| 1 + bytes[..offset].iter().filter(|&&b| b == b'\n').count() as u32;
@@ -282,6 +292,7 @@ pub(super) fn parse_scene_with(
             ids: HashMap::new(),
             aliases: HashMap::new(),
             path_folders: Vec::new(),
+            warnings: Vec::new(),
         },
         defaults: overrides.to_vec(),
         declared: Vec::new(),
@@ -307,7 +318,11 @@ pub(super) fn parse_scene_with(
                 "missing attribute \"version\" in <scene>",
             ));
         }
-        Some((_, version)) => check_version(version, root_location)?,
+        Some((_, version)) => {
+            if let Some(w) = check_version(version, root_location)? {
+                reader.tree.warnings.push(w);
+            }
+        }
     }
     reader.tree.elems.push(Elem {
         tag: "scene".into(),
@@ -346,7 +361,8 @@ fn parse_xml<'a>(text: &'a str, path: &Path) -> Result<roxmltree::Document<'a>> 
 }
 
 /// `version="major.minor.patch"`; scenes older than Mitsuba 2 use other parameter names.
-fn check_version(version: &str, location: impl Fn() -> Location) -> Result<()> {
+/// A version newer than Mitsuba 3 loads (Mitsuba 3 reads it without a word) with a warning.
+fn check_version(version: &str, location: impl Fn() -> Location) -> Result<Option<String>> {
     let parts: Vec<&str> = version.trim().split('.').collect();
     let numbers: Option<Vec<u32>> = parts.iter().map(|p| p.parse().ok()).collect();
     match numbers {
@@ -359,8 +375,14 @@ fn check_version(version: &str, location: impl Fn() -> Location) -> Result<()> {
                          names): convert it to Mitsuba 3 first"
                     ),
                 ))
+            } else if n[0] > 3 {
+                Ok(Some(format!(
+                    "{}: scene version {version} is newer than the Mitsuba 3 format mltbench \
+                     reads: parameters may have changed meaning",
+                    location()
+                )))
             } else {
-                Ok(())
+                Ok(None)
             }
         }
         _ => Err(Error::input(
@@ -513,6 +535,17 @@ impl Reader {
             return Err(Error::input(
                 location(),
                 format!("elements nested deeper than {MAX_ELEMENT_DEPTH} levels"),
+            ));
+        }
+        if tag == "spectrum"
+            && let Some((_, plugin)) = attrs.iter().find(|(k, _)| k == "type")
+        {
+            return Err(Error::input(
+                location(),
+                format!(
+                    "spectrum plugins (type=\"{plugin}\") are not supported yet: give the \
+                     spectrum as a value (\"400:0.5, 700:0.8\") or an <rgb>"
+                ),
             ));
         }
         check_attributes(&attrs, &tag, kind, location)?;
@@ -686,8 +719,10 @@ impl Reader {
             let attrs = self.substituted_attrs(&root, &path, line)?;
             let root_location = || Location::at(&path, line, "<scene>");
             check_attributes(&attrs, "scene", Kind::Scene, root_location)?;
-            if let Some((_, version)) = attrs.iter().find(|(k, _)| k == "version") {
-                check_version(version, root_location)?;
+            if let Some((_, version)) = attrs.iter().find(|(k, _)| k == "version")
+                && let Some(w) = check_version(version, root_location)?
+            {
+                self.tree.warnings.push(w);
             }
             self.expand_children(&doc, root, new_file, parent, parent_kind)?;
         } else {
