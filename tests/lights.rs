@@ -1202,27 +1202,37 @@ fn test_envmap(to_world: &Transform, scale: f32) -> EnvmapLight {
     .unwrap()
 }
 
+/// cos θ_j of texel row j of a lat-long map of `h` rows: θ_j = π j/(h − 1).
+fn envmap_cos_row(j: usize, h: usize) -> f64 {
+    (PI * j as f64 / (h - 1) as f64).cos()
+}
+
+/// The unnormalised sampling weight of envmap cell (i, j) of `t` (`w` × `h` texels): the cell
+/// spans texel columns i..i+1 (wrapping) and rows j..j+1, and its probability is ∝ mean
+/// corner luminance × (cos θ_j − cos θ_{j+1}).
+fn envmap_cell_weight(t: &[Rgb], w: usize, h: usize, i: usize, j: usize) -> f64 {
+    let i1 = (i + 1) % w;
+    let corners = [
+        t[j * w + i],
+        t[j * w + i1],
+        t[(j + 1) * w + i],
+        t[(j + 1) * w + i1],
+    ];
+    corners.iter().map(|&c| lum(c)).sum::<f64>() / 4.0
+        * (envmap_cos_row(j, h) - envmap_cos_row(j + 1, h))
+}
+
 #[test]
 fn envmap_sampling_matches_luminance_times_solid_angle() {
     let (w, h, t) = test_texels();
     let rot = rotation();
     let env = Light::Envmap(Box::new(test_envmap(&rot, 1.5)));
-    // Cell (i, j) spans texel columns i..i+1 (wrapping) and rows j..j+1; its probability
-    // is ∝ mean corner luminance × (cos θ_j − cos θ_{j+1}), with θ_j = π j/(H − 1).
     let rows = h - 1;
-    let cos_row = |j: usize| (PI * j as f64 / rows as f64).cos();
+    let cos_row = |j: usize| envmap_cos_row(j, h);
     let mut weight = vec![0.0; w * rows];
     for j in 0..rows {
         for i in 0..w {
-            let i1 = (i + 1) % w;
-            let corners = [
-                t[j * w + i],
-                t[j * w + i1],
-                t[(j + 1) * w + i],
-                t[(j + 1) * w + i1],
-            ];
-            weight[j * w + i] =
-                corners.iter().map(|&c| lum(c)).sum::<f64>() / 4.0 * (cos_row(j) - cos_row(j + 1));
+            weight[j * w + i] = envmap_cell_weight(&t, w, h, i, j);
         }
     }
     let total: f64 = weight.iter().sum();
@@ -1538,17 +1548,8 @@ fn envmap_texels_near_the_f32_limit() {
     let env = build(&t, 1.0).unwrap();
     assert!(env.power().is_finite() && env.power() > 0.0);
     let rows = h - 1;
-    let cos_row = |j: usize| (PI * j as f64 / rows as f64).cos();
-    let weight = |i: usize, j: usize| {
-        let i1 = (i + 1) % w;
-        let corners = [
-            t[j * w + i],
-            t[j * w + i1],
-            t[(j + 1) * w + i],
-            t[(j + 1) * w + i1],
-        ];
-        corners.iter().map(|&c| lum(c)).sum::<f64>() / 4.0 * (cos_row(j) - cos_row(j + 1))
-    };
+    let cos_row = |j: usize| envmap_cos_row(j, h);
+    let weight = |i: usize, j: usize| envmap_cell_weight(&t, w, h, i, j);
     let total: f64 = (0..rows)
         .flat_map(|j| (0..w).map(move |i| (i, j)))
         .map(|(i, j)| weight(i, j))

@@ -371,14 +371,20 @@ fn floor_under_a_point_light_follows_the_inverse_square_law() {
         floor_camera = floor_camera(),
         floor = floor(0.5)
     ));
-    let image = render_pt(&scene, &[], 4, 9);
+    assert_floor_lit_by_a_point(&scene, rho, intensity, light);
+}
+
+/// Pixels of the floor of albedo `rho` (`floor_camera`) under a point-like light of
+/// `intensity` at `light` show ρ/π · E with E = I cos θ / d². The only randomness is the
+/// position inside the pixel: within 1%.
+fn assert_floor_lit_by_a_point(scene: &Scene, rho: f64, intensity: f64, light: Vec3) {
+    let image = render_pt(scene, &[], 4, 9);
     for (x, y) in [(8, 8), (2, 3), (14, 12)] {
-        let expected = floor_pixel_average(&scene, x, y, |p| {
+        let expected = floor_pixel_average(scene, x, y, |p| {
             let d = light - p;
             intensity * (d.y / d.length()) as f64 / d.length_squared() as f64
         }) * rho
             / std::f64::consts::PI;
-        // The only randomness is the position inside the pixel: compare to 1%.
         let v = image.get(x, y)[0] as f64;
         assert!(
             (v / expected - 1.0).abs() < 0.01,
@@ -419,19 +425,7 @@ fn a_tiny_sphere_light_is_a_point_light() {
         floor_camera = floor_camera(),
         floor = floor(0.5)
     ));
-    let image = render_pt(&scene, &[], 4, 9);
-    for (x, y) in [(8, 8), (2, 3), (14, 12)] {
-        let expected = floor_pixel_average(&scene, x, y, |p| {
-            let d = light - p;
-            intensity * (d.y / d.length()) as f64 / d.length_squared() as f64
-        }) * rho
-            / std::f64::consts::PI;
-        let v = image.get(x, y)[0] as f64;
-        assert!(
-            (v / expected - 1.0).abs() < 0.01,
-            "pixel ({x},{y}) = {v}, expected {expected}"
-        );
-    }
+    assert_floor_lit_by_a_point(&scene, rho, intensity, light);
 }
 
 #[test]
