@@ -192,6 +192,7 @@ impl TestShape {
                         let point = LightPoint {
                             p: (o64 + w64 * tt).as_vec3(),
                             n,
+                            front: n,
                             primitive: i as u32,
                         };
                         best = Some((tt, point));
@@ -219,6 +220,7 @@ impl TestShape {
                 Some(LightPoint {
                     p: p.as_vec3(),
                     n: if *flip { -out } else { out },
+                    front: if *flip { -out } else { out },
                     primitive: 0,
                 })
             }
@@ -237,6 +239,7 @@ impl TestShape {
                 Some(LightPoint {
                     p: (o64 + w64 * t).as_vec3(),
                     n: *n,
+                    front: *n,
                     primitive: 0,
                 })
             }
@@ -2024,6 +2027,7 @@ fn degenerate_queries_stay_finite() {
                     let hit = LightPoint {
                         p: r,
                         n: d,
+                        front: d,
                         primitive: 0,
                     };
                     for q in [r, Vec3::ZERO] {

@@ -315,17 +315,44 @@ fn polygon_irradiance(p: Vec3, n: Vec3, vertices: &[Vec3]) -> f64 {
 
 #[test]
 fn floor_irradiance_under_a_rectangle_light_matches_lamberts_formula() {
-    // The Cornell box's floor and light (experiments/scenes/cbox.xml), nothing else; direct
-    // lighting only. Floor radiance = ρ/π · Le · E_unit.
+    // The Cornell box's floor and light (experiments/scenes/cbox.xml), nothing else.
+    assert_floor_under_the_cbox_light(
+        r#"<shape type="rectangle">
+            <transform name="to_world">
+                <scale x="0.23" y="0.19"/><rotate x="1" angle="90"/><translate y="0.99"/>
+            </transform>"#,
+        Path::new("test-scene.xml"),
+    );
+}
+
+/// The side a mesh emits from is its shading normal's (Mitsuba 3's convention): the same
+/// light as a quad wound to face up, with vertex normals pointing down, lights the floor.
+#[test]
+fn a_mesh_light_emits_towards_its_vertex_normals() {
+    let dir = std::env::temp_dir().join(format!("mltbench-pt-vn-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("light.obj"),
+        "v -0.23 0.99 -0.19\nv 0.23 0.99 -0.19\nv 0.23 0.99 0.19\nv -0.23 0.99 0.19\n\
+         vn 0 -1 0\nf 1//1 3//1 2//1\nf 1//1 4//1 3//1\n",
+    )
+    .unwrap();
+    assert_floor_under_the_cbox_light(
+        r#"<shape type="obj"><string name="filename" value="light.obj"/>"#,
+        &dir.join("scene.xml"),
+    );
+}
+
+/// Direct lighting only, from the shape opened by `light_shape` (the Cornell box light's
+/// rectangle, emitting downwards), on the floor: pixel means over 16 runs against
+/// ρ/π · Le · E_unit (Lambert's formula), within `SIGMAS`.
+fn assert_floor_under_the_cbox_light(light_shape: &str, scene_path: &Path) {
     let (rho, le) = (0.6f64, [18.387f64, 13.9873, 6.75357]);
-    let scene = scene(&format!(
+    let xml = format!(
         r#"<scene version="3.0.0">
             <integrator type="path"><integer name="max_depth" value="2"/></integrator>
             {floor_camera}
-            <shape type="rectangle">
-                <transform name="to_world">
-                    <scale x="0.23" y="0.19"/><rotate x="1" angle="90"/><translate y="0.99"/>
-                </transform>
+            {light_shape}
                 <bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>
                 <emitter type="area"><rgb name="radiance" value="18.387, 13.9873, 6.75357"/></emitter>
             </shape>
@@ -333,7 +360,9 @@ fn floor_irradiance_under_a_rectangle_light_matches_lamberts_formula() {
         </scene>"#,
         floor_camera = floor_camera(),
         floor = floor(0.6)
-    ));
+    );
+    let desc = mitsuba::load_str(&xml, scene_path).expect("scene loads");
+    let scene = Scene::build(desc).expect("scene builds");
     let light = [
         Vec3::new(-0.23, 0.99, -0.19),
         Vec3::new(0.23, 0.99, -0.19),

@@ -1,5 +1,7 @@
 //! Area lights: uniform radiance leaving the front side of a shape (Mitsuba 3's `area`
-//! emitter: one-sided, along the geometric normal).
+//! emitter: one-sided). The side is the shading normal's (`ShapePoint::front`: the
+//! interpolated vertex normal on meshes that have them, as Mitsuba 3 decides it), while
+//! densities convert between area and solid angle with the geometric normal.
 
 use glam::{Vec2, Vec3};
 
@@ -32,7 +34,7 @@ impl AreaLight {
 
     /// Radiance leaving `hit` towards `w` (unit or not): L on the front side, black behind.
     pub fn le(&self, hit: &LightPoint, w: Vec3) -> Rgb {
-        if hit.n.dot(w) > 0.0 {
+        if hit.front.dot(w) > 0.0 {
             self.radiance
         } else {
             Rgb::BLACK
@@ -49,13 +51,14 @@ impl AreaLight {
         }
         let wi = d / dist;
         // One-sided: the sampled point must face the reference point.
-        let faces_r = s.point.n.dot(wi) < 0.0; // false for NaN too
+        let faces_r = s.point.front.dot(wi) < 0.0; // false for NaN too
         if !faces_r {
             return None;
         }
         Some(LightSample {
             p: s.point.p,
             n: s.point.n,
+            front: s.point.front,
             primitive: s.point.primitive,
             wi,
             dist,
@@ -68,7 +71,7 @@ impl AreaLight {
 
     /// Solid-angle density of `sample_li(r, ·)` returning `hit`: 0 for points facing away.
     pub fn pdf_li(&self, r: Vec3, hit: &LightPoint) -> f32 {
-        let faces_r = hit.n.dot(r - hit.p) > 0.0; // false for NaN too
+        let faces_r = hit.front.dot(r - hit.p) > 0.0; // false for NaN too
         if !faces_r {
             return 0.0;
         }
@@ -83,7 +86,7 @@ impl AreaLight {
         if pdf_dir.is_nan() || pdf_dir <= 0.0 {
             return None;
         }
-        let direction = Frame::from_normal(point.n).to_world(local).normalize();
+        let direction = Frame::from_normal(point.front).to_world(local).normalize();
         Some(EmissionSample {
             origin: point.p,
             direction,

@@ -36,6 +36,7 @@ impl DirectionalLight {
         Some(LightSample {
             p: wi,
             n: self.direction,
+            front: self.direction,
             primitive: 0,
             wi,
             dist: f32::INFINITY,

@@ -75,6 +75,8 @@ pub struct LightSample {
     /// Unit geometric normal at `p` (area lights), −`wi` for lights at infinity, zero for
     /// point and spot lights.
     pub n: Vec3,
+    /// The normal of the side that emits (`ShapePoint::front`); `n` for other lights.
+    pub front: Vec3,
     /// Triangle index within the shape (0 otherwise).
     pub primitive: u32,
     /// Unit direction from the reference point towards `p`.
@@ -110,6 +112,7 @@ impl LightSample {
         LightSample {
             p: wi,
             n: -wi,
+            front: -wi,
             primitive: 0,
             wi,
             dist: f32::INFINITY,
@@ -126,6 +129,7 @@ impl LightSample {
         LightSample {
             p: position,
             n: Vec3::ZERO,
+            front: Vec3::ZERO,
             primitive: 0,
             wi,
             dist,
@@ -141,17 +145,20 @@ impl LightSample {
         LightPoint {
             p: self.p,
             n: self.n,
+            front: self.front,
             primitive: self.primitive,
         }
     }
 }
 
-/// A point on a light reached by a ray: position, unit geometric normal (the front side),
-/// triangle. For lights at infinity, `p` is the unit direction towards the light.
+/// A point on a light reached by a ray: position, unit geometric normal, the normal of the
+/// side that emits (`ShapePoint::front`), triangle. For lights at infinity, `p` is the unit
+/// direction towards the light.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LightPoint {
     pub p: Vec3,
     pub n: Vec3,
+    pub front: Vec3,
     pub primitive: u32,
 }
 
@@ -161,6 +168,7 @@ impl LightPoint {
         LightPoint {
             p: wi,
             n: -wi,
+            front: -wi,
             primitive: 0,
         }
     }
@@ -171,6 +179,7 @@ impl From<&SurfaceInteraction> for LightPoint {
         LightPoint {
             p: si.p,
             n: si.ng,
+            front: si.ns,
             primitive: si.primitive,
         }
     }

@@ -20,12 +20,16 @@ use crate::light::distribution::Distribution1D;
 use crate::math::{Frame, PI, Transform, warp};
 use crate::scene::{ShapeDesc, ShapeGeometry, TriangleMesh};
 
-/// A point on a shape with its unit geometric normal (front side) and the triangle it lies
-/// on (0 for analytic shapes).
+/// A point on a shape with its unit geometric normal, the normal of the side that emits, and
+/// the triangle it lies on (0 for analytic shapes).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShapePoint {
     pub p: Vec3,
+    /// The geometric normal: densities convert between area and solid angle with it.
     pub n: Vec3,
+    /// Which side emits: the interpolated vertex normal on meshes that have them, as in
+    /// Mitsuba 3 (which decides an emitter's side in the shading frame); `n` elsewhere.
+    pub front: Vec3,
     pub primitive: u32,
 }
 
@@ -140,6 +144,8 @@ fn area_to_solid_angle(pdf_area: f32, r: Vec3, p: Vec3, n: Vec3) -> f32 {
 pub struct MeshSampler {
     triangles: Vec<[Vec3; 3]>,
     normals: Vec<Vec3>,
+    /// The vertex normals of each kept triangle, when the mesh has them.
+    vertex_normals: Option<Vec<[Vec3; 3]>>,
     /// Index of each kept triangle in the mesh.
     primitives: Vec<u32>,
     /// Over the kept triangles, by area.
@@ -155,6 +161,7 @@ impl MeshSampler {
         let mut normals = Vec::new();
         let mut primitives = Vec::new();
         let mut areas = Vec::new();
+        let mut vertex_normals = mesh.normals.as_ref().map(|_| Vec::new());
         let mut total = 0.0f64;
         let n_vertices = mesh.positions.len();
         for (pi, idx) in mesh.indices.iter().enumerate() {
@@ -174,6 +181,9 @@ impl MeshSampler {
             total += area;
             triangles.push(v);
             normals.push(ng);
+            if let (Some(kept), Some(vn)) = (&mut vertex_normals, &mesh.normals) {
+                kept.push(idx.map(|i| vn.get(i as usize).copied().unwrap_or(Vec3::ZERO)));
+            }
             primitives.push(pi as u32);
             areas.push(area as f32);
         }
@@ -186,6 +196,7 @@ impl MeshSampler {
         Ok(MeshSampler {
             triangles,
             normals,
+            vertex_normals,
             primitives,
             by_area,
             area,
@@ -205,11 +216,29 @@ impl MeshSampler {
         let (i, _, ux) = self.by_area.sample_discrete(u.x);
         let b = warp::square_to_triangle(Vec2::new(ux, u.y));
         let [v0, v1, v2] = self.triangles[i];
+        let n = self.normals[i];
+        let front = match &self.vertex_normals {
+            None => n,
+            Some(vn) => interpolated_normal(vn[i], b, n),
+        };
         ShapePoint {
             p: v0 * (1.0 - b.x - b.y) + v1 * b.x + v2 * b.y,
-            n: self.normals[i],
+            n,
+            front,
             primitive: self.primitives[i],
         }
+    }
+}
+
+/// The normalised interpolation of vertex normals `vn` at barycentrics `b` (as the ray
+/// caster's shading normal), or `n` where it vanishes.
+fn interpolated_normal(vn: [Vec3; 3], b: Vec2, n: Vec3) -> Vec3 {
+    let [n0, n1, n2] = vn;
+    let interpolated = (n0 * (1.0 - b.x - b.y) + n1 * b.x + n2 * b.y).normalize_or_zero();
+    if interpolated == Vec3::ZERO {
+        n
+    } else {
+        interpolated
     }
 }
 
@@ -268,9 +297,11 @@ impl SphereSampler {
 
     fn sample_area(&self, u: Vec2) -> ShapePoint {
         let w = warp::square_to_sphere(u);
+        let n = self.normal_at(w);
         ShapePoint {
             p: self.center + w * self.radius,
-            n: self.normal_at(w),
+            n,
+            front: n,
             primitive: 0,
         }
     }
@@ -312,7 +343,12 @@ impl SphereSampler {
         let pdf_solid_angle = self.cone_pdf(r);
         let cos_light = n.dot(r - p).abs() / dist2.sqrt();
         Some(ShapeSample {
-            point: ShapePoint { p, n, primitive: 0 },
+            point: ShapePoint {
+                p,
+                n,
+                front: n,
+                primitive: 0,
+            },
             pdf_solid_angle,
             pdf_area: pdf_solid_angle * cos_light / dist2,
         })
@@ -366,6 +402,7 @@ impl DiskSampler {
         ShapePoint {
             p,
             n: self.n,
+            front: self.n,
             primitive: 0,
         }
     }
