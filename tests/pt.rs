@@ -267,9 +267,6 @@ fn floor_camera() -> String {
     sensor(28.0, "0,0.9,1.2", "0,-1,-0.1", 16)
 }
 
-/// Irradiance at `p` (normal `n`) from a uniform Lambertian polygon of unit radiance:
-/// Lambert's formula E = ½ Σ_i Θ_i (n · γ̂_i), Θ_i the angle the edge v_i v_{i+1} subtends
-/// at p and γ̂_i the unit normal of the plane through p and that edge (Arvo 1995, eq. 2).
 /// Mean and standard error of pixel (x, y), channel c, over independent runs.
 fn mean_over_runs(runs: &[Image], x: u32, y: u32, c: usize) -> (f64, f64) {
     let values: Vec<f64> = runs.iter().map(|im| im.get(x, y)[c] as f64).collect();
@@ -300,6 +297,9 @@ fn floor_pixel_average(scene: &Scene, x: u32, y: u32, f: impl Fn(Vec3) -> f64) -
     sum / 256.0
 }
 
+/// Irradiance at `p` (normal `n`) from a uniform Lambertian polygon of unit radiance:
+/// Lambert's formula E = ½ Σ_i Θ_i (n · γ̂_i), Θ_i the angle the edge v_i v_{i+1} subtends
+/// at p and γ̂_i the unit normal of the plane through p and that edge (Arvo 1995, eq. 2).
 fn polygon_irradiance(p: Vec3, n: Vec3, vertices: &[Vec3]) -> f64 {
     let mut sum = 0.0f64;
     for i in 0..vertices.len() {
