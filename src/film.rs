@@ -30,6 +30,7 @@
 
 use glam::Vec2;
 
+use crate::error::{Error, Result};
 use crate::image::Image;
 use crate::math::Rgb;
 use crate::scene::FilterDesc;
@@ -267,8 +268,17 @@ impl SplatList {
     }
 }
 
+/// `n` copies of `value`, or None when the memory cannot be had.
+fn try_filled<T: Copy>(n: usize, value: T) -> Option<Vec<T>> {
+    let mut buffer = Vec::new();
+    buffer.try_reserve_exact(n).ok()?;
+    buffer.resize(n, value);
+    Some(buffer)
+}
+
 impl Film {
-    pub fn new(width: u32, height: u32, filter: FilterDesc) -> Film {
+    /// A black film; an error when its buffers do not fit in memory.
+    pub fn new(width: u32, height: u32, filter: FilterDesc) -> Result<Film> {
         let filter = ReconstructionFilter::new(filter);
         let mass = |n: u32| -> Vec<f64> {
             (0..n)
@@ -280,19 +290,30 @@ impl Film {
                 .collect()
         };
         let pixels = width as usize * height as usize;
-        Film {
+        // A huge film under a memory limit is an error, not an abort.
+        let (Some(sums), Some(splats)) =
+            (try_filled(pixels, [0.0; 4]), try_filled(pixels, [0.0; 3]))
+        else {
+            let bytes = pixels as f64 * (size_of::<[f64; 4]>() + size_of::<[f64; 3]>()) as f64;
+            return Err(Error::usage(format!(
+                "a {width} × {height} film needs {:.1} GiB, more memory than this process can \
+                 allocate; render at a lower resolution (the film's width and height)",
+                bytes / (1u64 << 30) as f64
+            )));
+        };
+        Ok(Film {
             width,
             height,
             filter,
-            sums: vec![[0.0; 4]; pixels],
-            splats: vec![[0.0; 3]; pixels],
+            sums,
+            splats,
             splat_mass_x: mass(width),
             splat_mass_y: mass(height),
             samples: 0,
             invalid_samples: 0,
             scratch_x: Vec::new(),
             scratch_y: Vec::new(),
-        }
+        })
     }
 
     pub fn width(&self) -> u32 {

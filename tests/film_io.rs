@@ -49,7 +49,7 @@ fn whole(film: &Film) -> PixelRect {
 
 #[test]
 fn box_filter_adds_a_sample_to_its_own_pixel_only() {
-    let mut film = Film::new(8, 5, FilterDesc::Box);
+    let mut film = Film::new(8, 5, FilterDesc::Box).unwrap();
     let mut tile = film.tile(whole(&film));
     tile.add_sample(Vec2::new(3.7, 2.2), Rgb::new(1.0, 2.0, 3.0));
     // On a pixel's top-left corner: that pixel (floor).
@@ -83,7 +83,7 @@ fn gauss_by_hand(t: f64) -> f64 {
 
 #[test]
 fn gaussian_weights_of_one_sample_are_the_separable_truncated_gaussian() {
-    let mut film = Film::new(32, 32, GAUSS);
+    let mut film = Film::new(32, 32, GAUSS).unwrap();
     let mut tile = film.tile(PixelRect {
         x0: 8,
         y0: 16,
@@ -130,7 +130,7 @@ fn gaussian_weights_of_one_sample_are_the_separable_truncated_gaussian() {
 fn constant_radiance_develops_to_that_constant_everywhere() {
     for filter in [FilterDesc::Box, GAUSS, FilterDesc::Gaussian { stddev: 1.3 }] {
         let (w, h) = (13, 7);
-        let mut film = Film::new(w, h, filter);
+        let mut film = Film::new(w, h, filter).unwrap();
         let c = Rgb::new(0.3, 1.7, 5.0);
         let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
         for rect in film.tiles(4) {
@@ -194,7 +194,7 @@ fn tiles_merged_in_tile_order_are_bit_identical_for_any_thread_count() {
     for filter in [FilterDesc::Box, GAUSS] {
         let (w, h, spp) = (37, 23, 3);
         let reference = {
-            let mut film = Film::new(w, h, filter);
+            let mut film = Film::new(w, h, filter).unwrap();
             for rect in film.tiles(8) {
                 let tile = render_tile(&film, rect, spp);
                 film.merge_tile(&tile);
@@ -202,7 +202,7 @@ fn tiles_merged_in_tile_order_are_bit_identical_for_any_thread_count() {
             film.image(1.0)
         };
         for threads in [2usize, 3, 5] {
-            let mut film = Film::new(w, h, filter);
+            let mut film = Film::new(w, h, filter).unwrap();
             let rects = film.tiles(8);
             // Each thread takes every `threads`-th tile, in reverse: tiles finish in an
             // order unrelated to the tile order.
@@ -236,7 +236,7 @@ fn tiles_merged_in_tile_order_are_bit_identical_for_any_thread_count() {
         }
         // A different tiling adds the same samples in another grouping: equal up to
         // rounding, which checks the tiles' filter margins lose nothing.
-        let mut film = Film::new(w, h, filter);
+        let mut film = Film::new(w, h, filter).unwrap();
         for rect in film.tiles(5) {
             let tile = render_tile(&film, rect, spp);
             film.merge_tile(&tile);
@@ -256,8 +256,8 @@ fn tiles_merged_in_tile_order_are_bit_identical_for_any_thread_count() {
 fn merging_in_a_different_order_is_allowed_to_differ_only_by_rounding() {
     // Sanity check of the test above: the merge order is what fixes the bits, the sums
     // themselves are the same.
-    let mut a = Film::new(16, 16, GAUSS);
-    let mut b = Film::new(16, 16, GAUSS);
+    let mut a = Film::new(16, 16, GAUSS).unwrap();
+    let mut b = Film::new(16, 16, GAUSS).unwrap();
     let rects = a.tiles(4);
     let tiles: Vec<_> = rects.iter().map(|&r| render_tile(&a, r, 5)).collect();
     for t in &tiles {
@@ -275,7 +275,7 @@ fn merging_in_a_different_order_is_allowed_to_differ_only_by_rounding() {
 
 #[test]
 fn splats_add_with_the_scale() {
-    let mut film = Film::new(6, 4, FilterDesc::Box);
+    let mut film = Film::new(6, 4, FilterDesc::Box).unwrap();
     let mut tile = film.tile(whole(&film));
     tile.add_sample(Vec2::new(2.5, 1.5), Rgb::new(1.0, 1.0, 1.0));
     tile.add_sample(Vec2::new(2.25, 1.75), Rgb::new(3.0, 3.0, 3.0));
@@ -306,7 +306,7 @@ fn a_uniform_splat_density_develops_to_a_constant_with_either_filter() {
         (FilterDesc::Gaussian { stddev: 0.8 }, 2e-4),
     ] {
         let (w, h, n) = (9u32, 6u32, 32u32);
-        let mut film = Film::new(w, h, filter);
+        let mut film = Film::new(w, h, filter).unwrap();
         let mut list = SplatList::new();
         let v = 1.0 / (n * n) as f32;
         for j in 0..h * n {
@@ -329,8 +329,8 @@ fn a_uniform_splat_density_develops_to_a_constant_with_either_filter() {
 #[test]
 fn splat_lists_merge_like_direct_splats_and_clear_resets() {
     let mut rng = Xoshiro256PlusPlus::seed_from_u64(3);
-    let mut direct = Film::new(20, 10, GAUSS);
-    let mut merged = Film::new(20, 10, GAUSS);
+    let mut direct = Film::new(20, 10, GAUSS).unwrap();
+    let mut merged = Film::new(20, 10, GAUSS).unwrap();
     let mut lists = vec![SplatList::new(), SplatList::new()];
     for k in 0..500 {
         let p = Vec2::new(rng.random::<f32>() * 20.0, rng.random::<f32>() * 10.0);
@@ -350,7 +350,7 @@ fn splat_lists_merge_like_direct_splats_and_clear_resets() {
 
 #[test]
 fn non_finite_samples_are_dropped_and_counted() {
-    let mut film = Film::new(4, 4, GAUSS);
+    let mut film = Film::new(4, 4, GAUSS).unwrap();
     let mut tile = film.tile(whole(&film));
     tile.add_sample(Vec2::new(1.5, 1.5), Rgb::new(1.0, 1.0, 1.0));
     tile.add_sample(Vec2::new(1.5, 1.5), Rgb::new(f32::NAN, 1.0, 1.0));

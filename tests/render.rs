@@ -303,7 +303,7 @@ fn invalid_samples_are_counted_and_never_reach_the_film() {
     use mltbench::estimator::Estimator;
     use mltbench::estimator::camera_pass::CameraEstimator;
     let scene = load_small(&scenes_dir().join("cbox.xml"), 16);
-    let mut est = CameraEstimator::new("poisoned", &scene, 1, Poisoned);
+    let mut est = CameraEstimator::new("poisoned", &scene, 1, Poisoned).unwrap();
     est.run_pass(&scene, 0);
     est.run_pass(&scene, 1);
     let stats = est.stats();
@@ -384,6 +384,40 @@ fn cli_refuses_outputs_that_would_lose_or_overwrite_files() {
     for f in ["out.json", "out.png", "taken.exr", "scene.exr"] {
         assert!(!dir.join(f).exists(), "{f} was written");
     }
+}
+
+/// A film larger than the process may allocate (16384² pixels, 14 GiB of sums, under a
+/// 3 GB address-space limit) is a clear error naming its size, not an abort.
+#[test]
+fn cli_refuses_a_film_that_does_not_fit_in_memory() {
+    let dir = temp_dir("huge_film");
+    let scene = scenes_dir().join("cbox.xml");
+    let run = Command::new("sh")
+        .arg("-c")
+        .arg(r#"ulimit -v 3000000 && exec "$@""#)
+        .arg("sh")
+        .arg(env!("CARGO_BIN_EXE_mltbench"))
+        .args(["render", scene.to_str().unwrap(), "--estimator", "pt"])
+        .args([
+            "-D",
+            "res=16384",
+            "--spp",
+            "1",
+            "--threads",
+            "1",
+            "-o",
+            "huge.exr",
+        ])
+        .current_dir(&dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("16384 × 16384 film needs 14.0 GiB"),
+        "{stderr}"
+    );
+    assert!(!dir.join("huge.exr").exists());
 }
 
 /// `compare` names the two files when they do not fit together, and refuses a reference

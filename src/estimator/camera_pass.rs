@@ -8,6 +8,7 @@ use rayon::prelude::*;
 
 use super::{Estimator, Stats};
 use crate::camera::raster_in_pixel;
+use crate::error::Result;
 use crate::film::{Film, FilmTile};
 use crate::geometry::Ray;
 use crate::image::Image;
@@ -100,16 +101,17 @@ pub struct CameraEstimator<S> {
 }
 
 impl<S: CameraSampleFn + Send> CameraEstimator<S> {
-    pub fn new(name: &'static str, scene: &Scene, seed: u64, sample: S) -> Self {
+    /// An error when the film does not fit in memory.
+    pub fn new(name: &'static str, scene: &Scene, seed: u64, sample: S) -> Result<Self> {
         let film = &scene.description.sensor.film;
-        CameraEstimator {
+        Ok(CameraEstimator {
             name,
-            film: Film::new(film.width, film.height, film.filter),
+            film: Film::new(film.width, film.height, film.filter)?,
             seed,
             stats: Stats::default(),
             sample,
             pixel_samples: Arc::new(PixelSamples::Independent),
-        }
+        })
     }
 
     /// Places the camera samples inside their pixels with `pixel_samples`.

@@ -4,6 +4,7 @@
 //! A miss shows the constant environment emitter, if the scene has one, else black.
 
 use super::camera_pass::{CameraEstimator, CameraSampleFn};
+use crate::error::Result;
 use crate::geometry::Ray;
 use crate::math::Rgb;
 use crate::sampler::pixel_samples::CameraSampler;
@@ -15,8 +16,8 @@ const MAX_NULL_CROSSINGS: u32 = 64;
 /// The `eyelight` estimator.
 pub type EyeLight = CameraEstimator<Shade>;
 
-/// Makes `eyelight` for `scene`.
-pub fn new(scene: &Scene, seed: u64) -> EyeLight {
+/// Makes `eyelight` for `scene`; an error when its film does not fit in memory.
+pub fn new(scene: &Scene, seed: u64) -> Result<EyeLight> {
     let background = scene
         .description
         .emitters

@@ -65,10 +65,10 @@ fn unknown_estimator(name: &str) -> Error {
 pub fn create(name: &str, params: &Params, scene: &Scene, seed: u64) -> Result<Box<dyn Estimator>> {
     let estimator: Box<dyn Estimator> = match name {
         "eyelight" => Box::new(
-            eyelight::new(scene, seed).with_pixel_samples(pixel_samples(params, scene, seed)?),
+            eyelight::new(scene, seed)?.with_pixel_samples(pixel_samples(params, scene, seed)?),
         ),
         "pt" => Box::new(
-            pt::new(scene, seed, pt::PtSettings::from_params(params, scene)?)
+            pt::new(scene, seed, pt::PtSettings::from_params(params, scene)?)?
                 .with_pixel_samples(pixel_samples(params, scene, seed)?),
         ),
         _ => return Err(unknown_estimator(name)),

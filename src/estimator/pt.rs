@@ -72,8 +72,8 @@ impl PtSettings {
 /// The `pt` estimator.
 pub type PathTracer = CameraEstimator<PathSample>;
 
-/// Makes `pt` for `scene` with `settings`.
-pub fn new(scene: &Scene, seed: u64, settings: PtSettings) -> PathTracer {
+/// Makes `pt` for `scene` with `settings`; an error when its film does not fit in memory.
+pub fn new(scene: &Scene, seed: u64, settings: PtSettings) -> Result<PathTracer> {
     CameraEstimator::new("pt", scene, seed, PathSample { settings })
 }
 
