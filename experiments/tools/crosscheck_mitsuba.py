@@ -147,7 +147,11 @@ def worker(job_file):
         img, passes = render(spp)
         seconds = time.perf_counter() - t0
         exr = Path(job["outdir"]) / f"mitsuba-{job['name']}-spp{spp}.exr"
+        # Bitmap.write waits on a task of the pool, which a pool of one thread (the
+        # caller, busy waiting) never runs: widen it for the write, untimed.
+        dr.set_thread_count(max(2, job["threads"]))
         mi.Bitmap(img).write(str(exr))
+        dr.set_thread_count(job["threads"])
         out["runs"].append({"spp": spp, "seconds": seconds, "passes": passes, "exr": str(exr)})
     Path(job["result"]).write_text(json.dumps(out))
 
