@@ -1429,6 +1429,15 @@ fn area_emitters_point_at_their_shape() {
     );
     assert_eq!(desc.shapes[2].emitter, Some(2));
     assert_eq!(desc.shapes[0].emitter, None);
+    // Without a BSDF, a shape is diffuse 0.5 but an emitting one is black (Mitsuba 3's
+    // Shape constructor): a lamp reflects nothing.
+    let reflectance = |shape: usize| match desc.bsdfs[desc.shapes[shape].bsdf] {
+        BsdfDesc::Diffuse { reflectance } => reflectance,
+        ref other => panic!("default BSDF {other:?}"),
+    };
+    assert_eq!(reflectance(0), Rgb::splat(0.5));
+    assert_eq!(reflectance(1), Rgb::BLACK);
+    assert_eq!(reflectance(2), Rgb::BLACK);
 }
 
 #[test]

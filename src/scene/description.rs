@@ -318,8 +318,8 @@ pub struct ShapeDesc {
     /// The `id` attribute, or `type@file:line` when it has none; for messages.
     pub name: String,
     pub geometry: ShapeGeometry,
-    /// Index into `SceneDescription::bsdfs` (a shape with no BSDF gets a white diffuse one,
-    /// as in Mitsuba).
+    /// Index into `SceneDescription::bsdfs` (a shape with no BSDF gets a diffuse one of
+    /// reflectance 0.5, or 0 if it emits, as in Mitsuba).
     pub bsdf: usize,
     /// Index into `SceneDescription::emitters` of its area emitter.
     pub emitter: Option<usize>,

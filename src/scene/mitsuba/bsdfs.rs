@@ -2,6 +2,7 @@
 //!
 //! Defaults (checked against Mitsuba 3's plugin sources):
 //! - `diffuse`: reflectance 0.5.
+//! - a shape without a BSDF: `diffuse` 0.5, or 0 (black) if it has an area emitter.
 //! - `conductor`, `roughconductor`: `material` "none" (a perfect mirror, no Fresnel term);
 //!   given `eta` and/or `k`, the missing one defaults to eta 0 / k 1; specular_reflectance 1.
 //! - rough models: `distribution` beckmann, `alpha` 0.1 (or `alpha_u` + `alpha_v`, both
@@ -78,11 +79,15 @@ impl Builder<'_> {
         Ok(index)
     }
 
-    /// Mitsuba's BSDF for shapes that name none: diffuse with reflectance 0.5.
-    pub(super) fn default_bsdf_index(&mut self) -> usize {
-        *self.default_bsdf.get_or_insert_with(|| {
+    /// Mitsuba's BSDF for shapes that name none: diffuse with reflectance 0.5, but 0 (black)
+    /// on a shape with an area emitter. Mitsuba 3's `Shape` constructor (src/render/shape.cpp)
+    /// sets `reflectance` 0 for emitters; with 0.5, light scattered back onto a lamp (e.g. a
+    /// small emitter inside a glass sphere) came out about 2% brighter than in Mitsuba.
+    pub(super) fn default_bsdf_index(&mut self, emitter: bool) -> usize {
+        let reflectance = if emitter { 0.0 } else { 0.5 };
+        *self.default_bsdf[emitter as usize].get_or_insert_with(|| {
             self.desc.bsdfs.push(BsdfDesc::Diffuse {
-                reflectance: Rgb::splat(0.5),
+                reflectance: Rgb::splat(reflectance),
             });
             self.desc.bsdfs.len() - 1
         })

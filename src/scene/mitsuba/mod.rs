@@ -67,7 +67,8 @@ pub(super) struct Builder<'a> {
     parsed_bsdfs: HashMap<ElemId, BsdfDesc>,
     /// Index in `desc.bsdfs` of each BSDF element used by a shape or written at top level.
     bsdf_indices: HashMap<ElemId, usize>,
-    default_bsdf: Option<usize>,
+    /// Index of the default BSDF of shapes without one: [not emitting, emitting].
+    default_bsdf: [Option<usize>; 2],
     /// Area emitter element → the shape it is attached to.
     attached_emitters: HashMap<ElemId, usize>,
     /// The (only) environment emitter.
@@ -91,7 +92,7 @@ impl<'a> Builder<'a> {
             desc,
             parsed_bsdfs: HashMap::new(),
             bsdf_indices: HashMap::new(),
-            default_bsdf: None,
+            default_bsdf: [None, None],
             attached_emitters: HashMap::new(),
             environment: None,
             in_progress: HashSet::new(),

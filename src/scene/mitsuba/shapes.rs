@@ -166,7 +166,7 @@ impl Builder<'_> {
         };
         let bsdf = match bsdf {
             Some(index) => index,
-            None => self.default_bsdf_index(),
+            None => self.default_bsdf_index(emitter.is_some()),
         };
         let index = self.desc.shapes.len();
         let emitter_index = emitter.map(|(emitter_elem, radiance)| {
