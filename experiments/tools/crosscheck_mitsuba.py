@@ -92,7 +92,11 @@ def worker(job_file):
     if job.get("llvm_lanes") and job["variant"].startswith("llvm"):
         set_llvm_lanes(job["llvm_lanes"])
     # The pool's size counts the calling thread, which works too: T means T busy threads.
-    dr.set_thread_count(job["threads"])
+    # Loading and writing images wait on pool tasks, which a pool of one (the caller, busy
+    # waiting) never runs: Mitsuba 3.9 hangs loading an envmap with one thread. Those steps
+    # run with at least two; the renders with T.
+    io_threads = max(2, job["threads"])
+    dr.set_thread_count(io_threads)
     scene_path = job["scene"]
     spps = job["spps"]
     # Scenes that declare `<default name="spp">` take the sample count as a parameter;
@@ -104,6 +108,7 @@ def worker(job_file):
     t0 = time.perf_counter()
     scene = mi.load_file(scene_path, **params)
     load_seconds = time.perf_counter() - t0
+    dr.set_thread_count(job["threads"])
     film = scene.sensors()[0].film()
     width, height = (int(v) for v in film.crop_size())
     rfilter = str(film.rfilter()).split("[")[0]
@@ -147,9 +152,7 @@ def worker(job_file):
         img, passes = render(spp)
         seconds = time.perf_counter() - t0
         exr = Path(job["outdir"]) / f"mitsuba-{job['name']}-spp{spp}.exr"
-        # Bitmap.write waits on a task of the pool, which a pool of one thread (the
-        # caller, busy waiting) never runs: widen it for the write, untimed.
-        dr.set_thread_count(max(2, job["threads"]))
+        dr.set_thread_count(io_threads)  # untimed
         mi.Bitmap(img).write(str(exr))
         dr.set_thread_count(job["threads"])
         out["runs"].append({"spp": spp, "seconds": seconds, "passes": passes, "exr": str(exr)})
