@@ -1011,13 +1011,28 @@ fn every_bsdf_has_mitsubas_defaults() {
     }
 }
 
+/// Anisotropic roughness is refused, naming the BSDF's line: the shading frame's tangent
+/// is not Mitsuba's dp/du, so the highlight would turn differently (README "Scenes").
+#[test]
+fn anisotropic_roughness_is_an_error_naming_file_and_line() {
+    for kind in ["roughconductor", "roughdielectric", "roughplastic"] {
+        let body = format!(
+            "<bsdf type=\"{kind}\">\n<float name=\"alpha_u\" value=\"0.05\"/>\
+             <float name=\"alpha_v\" value=\"0.3\"/></bsdf>"
+        );
+        let (message, file) = load_err("anisotropic", &with_sphere(&body));
+        assert_names(&message, &file, 3);
+        assert!(message.contains("alpha_u = 0.05 and alpha_v = 0.3 differ"), "{message}");
+    }
+}
+
 #[test]
 fn bsdf_parameters_land_in_their_fields() {
     assert_eq!(
         bsdf_of(
             r#"<bsdf type="roughconductor">
                  <string name="distribution" value="ggx"/>
-                 <float name="alpha_u" value="0.05"/><float name="alpha_v" value="0.3"/>
+                 <float name="alpha_u" value="0.05"/><float name="alpha_v" value="0.05"/>
                  <boolean name="sample_visible" value="false"/>
                  <rgb name="eta" value="0.2, 0.9, 1.1"/><rgb name="k" value="3.9, 2.4, 2.2"/>
                  <rgb name="specular_reflectance" value="0.9"/>
@@ -1030,7 +1045,7 @@ fn bsdf_parameters_land_in_their_fields() {
             roughness: Roughness {
                 kind: MicrofacetKind::Ggx,
                 alpha_u: 0.05,
-                alpha_v: 0.3,
+                alpha_v: 0.05,
                 sample_visible: false
             },
         }

@@ -6,7 +6,7 @@
 //! - `conductor`, `roughconductor`: `material` "none" (a perfect mirror, no Fresnel term);
 //!   given `eta` and/or `k`, the missing one defaults to eta 0 / k 1; specular_reflectance 1.
 //! - rough models: `distribution` beckmann, `alpha` 0.1 (or `alpha_u` + `alpha_v`, both
-//!   required), `sample_visible` true; α = 0 is raised to 10⁻⁴ with a warning, as Mitsuba does.
+//!   required and equal: anisotropy is refused), `sample_visible` true; α = 0 is raised to 10⁻⁴ with a warning, as Mitsuba does.
 //! - `dielectric`, `thindielectric`, `roughdielectric`: int_ior bk7 (1.5046), ext_ior air
 //!   (1.000277), specular_reflectance and specular_transmittance 1.
 //! - `plastic`, `roughplastic`: int_ior polypropylene (1.49), ext_ior air, diffuse_reflectance
@@ -323,10 +323,20 @@ impl Builder<'_> {
             },
         };
         let (alpha_u, alpha_v) = self.alphas(props)?;
-        if !anisotropic && alpha_u != alpha_v {
+        if alpha_u != alpha_v {
+            // The models are anisotropic (tests/bsdf.rs checks them against Mitsuba in the
+            // local frame), but a surface's shading frame is built from its normal alone,
+            // not from dp/du as Mitsuba's is: the highlight would turn the wrong way.
+            let why = if anisotropic {
+                "anisotropic roughness is not supported: mltbench's shading frame does not \
+                 follow the surface's dp/du as Mitsuba 3's does, so the highlight would be \
+                 oriented differently"
+            } else {
+                "this BSDF supports only isotropic roughness"
+            };
             return Err(tree.error(
                 props.owner(),
-                "this BSDF supports only isotropic roughness (alpha_u = alpha_v)",
+                format!("alpha_u = {alpha_u} and alpha_v = {alpha_v} differ: {why}"),
             ));
         }
         let sample_visible = props.boolean("sample_visible")?.unwrap_or(true);
