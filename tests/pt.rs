@@ -344,6 +344,28 @@ fn a_mesh_light_emits_towards_its_vertex_normals() {
     );
 }
 
+/// Densities convert between area and solid angle with the geometric normal, whatever the
+/// vertex normals say: a quad light whose four vertex normals lean 25–35° apart (all still
+/// facing the floor) lights it by Lambert's formula like the flat quad. Mitsuba 3 converts
+/// with the shading normal, and its light sampling then disagrees with its own BSDF sampling
+/// (experiments/tools/CROSSCHECK.md); this pins mltbench to the physically right answer.
+#[test]
+fn a_mesh_lights_densities_ignore_its_leaning_vertex_normals() {
+    let dir = std::env::temp_dir().join(format!("mltbench-pt-lean-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("light.obj"),
+        "v -0.23 0.99 -0.19\nv 0.23 0.99 -0.19\nv 0.23 0.99 0.19\nv -0.23 0.99 0.19\n\
+         vn -0.5 -1 -0.4\nvn 0.5 -1 -0.3\nvn 0.3 -1 0.5\nvn -0.4 -1 0.4\n\
+         f 1//1 2//2 3//3\nf 1//1 3//3 4//4\n",
+    )
+    .unwrap();
+    assert_floor_under_the_cbox_light(
+        r#"<shape type="obj"><string name="filename" value="light.obj"/>"#,
+        &dir.join("scene.xml"),
+    );
+}
+
 /// Direct lighting only, from the shape opened by `light_shape` (the Cornell box light's
 /// rectangle, emitting downwards), on the floor: pixel means over 16 runs against
 /// ρ/π · Le · E_unit (Lambert's formula), within `SIGMAS`.

@@ -1022,7 +1022,10 @@ fn anisotropic_roughness_is_an_error_naming_file_and_line() {
         );
         let (message, file) = load_err("anisotropic", &with_sphere(&body));
         assert_names(&message, &file, 3);
-        assert!(message.contains("alpha_u = 0.05 and alpha_v = 0.3 differ"), "{message}");
+        assert!(
+            message.contains("alpha_u = 0.05 and alpha_v = 0.3 differ"),
+            "{message}"
+        );
     }
 }
 
