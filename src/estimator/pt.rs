@@ -137,7 +137,8 @@ impl PathSample {
             return (Rgb::BLACK, 0);
         }
         let shadow = if ls.dist.is_finite() {
-            si.spawn_ray_to(ls.p)
+            // Point and spot lights have no error box and no normal: no offset at their end.
+            si.spawn_ray_to_surface(ls.p, ls.p_error, ls.n)
         } else {
             si.spawn_ray(ls.wi)
         };

@@ -59,6 +59,7 @@ impl AreaLight {
             p: s.point.p,
             n: s.point.n,
             front: s.point.front,
+            p_error: s.point.p_error,
             primitive: s.point.primitive,
             wi,
             dist,

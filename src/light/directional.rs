@@ -37,6 +37,7 @@ impl DirectionalLight {
             p: wi,
             n: self.direction,
             front: self.direction,
+            p_error: Vec3::ZERO,
             primitive: 0,
             wi,
             dist: f32::INFINITY,

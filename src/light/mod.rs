@@ -77,6 +77,8 @@ pub struct LightSample {
     pub n: Vec3,
     /// The normal of the side that emits (`ShapePoint::front`); `n` for other lights.
     pub front: Vec3,
+    /// Rounding-error bound of `p` on area lights (`ShapePoint::p_error`); zero otherwise.
+    pub p_error: Vec3,
     /// Triangle index within the shape (0 otherwise).
     pub primitive: u32,
     /// Unit direction from the reference point towards `p`.
@@ -113,6 +115,7 @@ impl LightSample {
             p: wi,
             n: -wi,
             front: -wi,
+            p_error: Vec3::ZERO,
             primitive: 0,
             wi,
             dist: f32::INFINITY,
@@ -130,6 +133,7 @@ impl LightSample {
             p: position,
             n: Vec3::ZERO,
             front: Vec3::ZERO,
+            p_error: Vec3::ZERO,
             primitive: 0,
             wi,
             dist,

@@ -16,6 +16,7 @@
 
 use glam::{DMat4, DVec3, Mat4, Vec2, Vec3};
 
+use crate::geometry::offset::gamma;
 use crate::light::distribution::Distribution1D;
 use crate::math::{Frame, PI, Transform, warp};
 use crate::scene::{ShapeDesc, ShapeGeometry, TriangleMesh};
@@ -30,6 +31,9 @@ pub struct ShapePoint {
     /// Which side emits: the interpolated vertex normal on meshes that have them, as in
     /// Mitsuba 3 (which decides an emitter's side in the shading frame); `n` elsewhere.
     pub front: Vec3,
+    /// A bound on the absolute rounding error of each coordinate of `p` (the true point on
+    /// the shape lies in `p ± p_error`), so that rays can stop short of it robustly.
+    pub p_error: Vec3,
     pub primitive: u32,
 }
 
@@ -221,10 +225,13 @@ impl MeshSampler {
             None => n,
             Some(vn) => interpolated_normal(vn[i], b, n),
         };
+        let b0 = 1.0 - b.x - b.y;
         ShapePoint {
-            p: v0 * (1.0 - b.x - b.y) + v1 * b.x + v2 * b.y,
+            p: v0 * b0 + v1 * b.x + v2 * b.y,
             n,
             front,
+            // Barycentric interpolation: Pharr, Jakob & Humphreys, PBR 4th ed., §6.8.5.
+            p_error: (v0.abs() * b0 + v1.abs() * b.x + v2.abs() * b.y) * gamma(6),
             primitive: self.primitives[i],
         }
     }
@@ -266,6 +273,12 @@ impl SphereSampler {
         })
     }
 
+    /// A bound on the error of a sampled point: centre + radius · unit vector in f32 (the
+    /// cone's f64 arithmetic, rounded once, stays inside it too).
+    fn p_error(&self) -> Vec3 {
+        (self.center.abs() + Vec3::splat(self.radius)) * gamma(5)
+    }
+
     fn normal_at(&self, outward: Vec3) -> Vec3 {
         if self.flip_normals { -outward } else { outward }
     }
@@ -302,6 +315,7 @@ impl SphereSampler {
             p: self.center + w * self.radius,
             n,
             front: n,
+            p_error: self.p_error(),
             primitive: 0,
         }
     }
@@ -347,6 +361,7 @@ impl SphereSampler {
                 p,
                 n,
                 front: n,
+                p_error: self.p_error(),
                 primitive: 0,
             },
             pdf_solid_angle,
@@ -403,6 +418,8 @@ impl DiskSampler {
             p,
             n: self.n,
             front: self.n,
+            // Transformed in f64 and rounded once to f32.
+            p_error: p.abs() * gamma(2),
             primitive: 0,
         }
     }
