@@ -330,17 +330,9 @@ fn floor_irradiance_under_a_rectangle_light_matches_lamberts_formula() {
 /// light as a quad wound to face up, with vertex normals pointing down, lights the floor.
 #[test]
 fn a_mesh_light_emits_towards_its_vertex_normals() {
-    let dir = std::env::temp_dir().join(format!("mltbench-pt-vn-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(
-        dir.join("light.obj"),
-        "v -0.23 0.99 -0.19\nv 0.23 0.99 -0.19\nv 0.23 0.99 0.19\nv -0.23 0.99 0.19\n\
-         vn 0 -1 0\nf 1//1 3//1 2//1\nf 1//1 4//1 3//1\n",
-    )
-    .unwrap();
-    assert_floor_under_the_cbox_light(
-        r#"<shape type="obj"><string name="filename" value="light.obj"/>"#,
-        &dir.join("scene.xml"),
+    assert_floor_under_the_cbox_light_as_obj(
+        "vn",
+        "vn 0 -1 0\nf 1//1 3//1 2//1\nf 1//1 4//1 3//1\n",
     );
 }
 
@@ -351,13 +343,24 @@ fn a_mesh_light_emits_towards_its_vertex_normals() {
 /// (experiments/tools/CROSSCHECK.md); this pins mltbench to the physically right answer.
 #[test]
 fn a_mesh_lights_densities_ignore_its_leaning_vertex_normals() {
-    let dir = std::env::temp_dir().join(format!("mltbench-pt-lean-{}", std::process::id()));
+    assert_floor_under_the_cbox_light_as_obj(
+        "lean",
+        "vn -0.5 -1 -0.4\nvn 0.5 -1 -0.3\nvn 0.3 -1 0.5\nvn -0.4 -1 0.4\n\
+         f 1//1 2//2 3//3\nf 1//1 3//3 4//4\n",
+    );
+}
+
+/// `assert_floor_under_the_cbox_light` for the Cornell box light's four corners written as
+/// an OBJ, followed by `normals_and_faces` (its `vn` and `f` lines).
+fn assert_floor_under_the_cbox_light_as_obj(name: &str, normals_and_faces: &str) {
+    let dir = std::env::temp_dir().join(format!("mltbench-pt-{name}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(
         dir.join("light.obj"),
-        "v -0.23 0.99 -0.19\nv 0.23 0.99 -0.19\nv 0.23 0.99 0.19\nv -0.23 0.99 0.19\n\
-         vn -0.5 -1 -0.4\nvn 0.5 -1 -0.3\nvn 0.3 -1 0.5\nvn -0.4 -1 0.4\n\
-         f 1//1 2//2 3//3\nf 1//1 3//3 4//4\n",
+        format!(
+            "v -0.23 0.99 -0.19\nv 0.23 0.99 -0.19\nv 0.23 0.99 0.19\nv -0.23 0.99 0.19\n\
+             {normals_and_faces}"
+        ),
     )
     .unwrap();
     assert_floor_under_the_cbox_light(
