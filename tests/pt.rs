@@ -6,7 +6,9 @@
 //! * specular objects (mirror, glass, thin glass) inside such an enclosure are invisible;
 //! * an emitter seen directly shows exactly its radiance, from the front only;
 //! * direct illumination of a floor by a rectangular light matches Lambert's polygon formula;
-//! * a lamp without a BSDF reflects nothing (Mitsuba's default), also inside a glass sphere.
+//! * a lamp without a BSDF reflects nothing (Mitsuba's default), also inside a glass sphere;
+//! * `hide_emitters` removes exactly the emission camera rays find: Le·Σ_{1≤j<d} a^j in the
+//!   furnace; lamps seen through `null` surfaces and anything in mirrors stay.
 
 use std::path::Path;
 
@@ -616,4 +618,90 @@ fn a_lamp_without_bsdf_reflects_nothing_even_inside_glass() {
         (mean, (var / n).sqrt()),
         0.0,
     );
+}
+
+#[test]
+fn hide_emitters_removes_only_what_camera_rays_find() {
+    // In the furnace the camera's first vertex adds Le; hidden, the image is
+    // Le·Σ_{1≤j<d} a^j = Le·a·(1 − a^(d−1))/(1 − a), and Le·a/(1 − a) unbounded.
+    let (a, le) = (0.6f64, 1.5f64);
+    for (max_depth, seed) in [(1, 31), (2, 32), (4, 33), (-1, 34)] {
+        let scene = furnace("sphere", "0.6", "1.5", max_depth, "");
+        let image = render_pt(&scene, &["hide_emitters=true"], 64, seed);
+        let expected = if max_depth < 0 {
+            le * a / (1.0 - a)
+        } else {
+            le * a * (1.0 - a.powi(max_depth - 1)) / (1.0 - a)
+        };
+        assert_within_sigmas(
+            &format!("hidden furnace, max_depth {max_depth}"),
+            pixel_mean(&image, 1, |_, _| true),
+            expected,
+        );
+    }
+
+    // Under a sky of 1.5: a lamp (radiance 3, no BSDF: black), part of it behind a `null`
+    // sheet, a mirror facing the camera (reflecting only sky), and a second null sheet with
+    // only sky behind it. Every pixel below has
+    // zero variance: what is hidden is exactly 0, what stays exactly its radiance.
+    let scene = scene(&format!(
+        r#"<scene version="3.0.0">
+            <integrator type="path"><integer name="max_depth" value="3"/>
+                <boolean name="hide_emitters" value="true"/></integrator>
+            {camera}
+            <emitter type="constant"><rgb name="radiance" value="1.5"/></emitter>
+            <shape type="rectangle">
+                <transform name="to_world"><translate x="-1" z="-3"/></transform>
+                <emitter type="area"><rgb name="radiance" value="3"/></emitter></shape>
+            <shape type="rectangle">
+                <transform name="to_world"><scale value="0.3"/><translate x="-0.667" z="-2"/></transform>
+                <bsdf type="null"/></shape>
+            <shape type="rectangle">
+                <transform name="to_world"><scale value="0.8"/><translate x="1.2" z="-3"/></transform>
+                <bsdf type="conductor"/></shape>
+            <shape type="rectangle">
+                <transform name="to_world"><scale value="0.4"/><translate x="0.3" y="-1.3" z="-2"/></transform>
+                <bsdf type="null"/></shape>
+        </scene>"#,
+        camera = sensor(90.0, "0,0,0", "0,0,-1", 32)
+    ));
+    let scene_ref = &scene;
+    let sees = |shape: u32| move |x: u32, y: u32| pixel_sees_only(scene_ref, x, y, shape);
+    let sky = |x: u32, y: u32| {
+        [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)]
+            .iter()
+            .all(|&(u, v)| {
+                let raster = raster_in_pixel(x, y, Vec2::new(u, v) * 0.999 + 0.0005);
+                scene
+                    .geometry
+                    .intersect(&scene.camera.generate_ray(raster))
+                    .is_none()
+            })
+    };
+    let cases: [(&str, &dyn Fn(u32, u32) -> bool, f64, f64); 5] = [
+        ("sky seen directly", &sky, 1.5, 0.0),
+        ("lamp seen directly", &sees(0), 3.0, 0.0),
+        // Mitsuba 3.9 (llvm_ad_rgb) renders these two the same way: a lamp through a null
+        // surface shows, the sky through one does not.
+        ("lamp through a null sheet", &sees(1), 3.0, 3.0),
+        ("sky in the mirror", &sees(2), 1.5, 1.5),
+        ("sky through a null sheet", &sees(3), 1.5, 0.0),
+    ];
+    let shown = render_pt(&scene, &["hide_emitters=false"], 4, 35);
+    let hidden = render_pt(&scene, &[], 4, 36);
+    for (what, keep, visible, expected_hidden) in cases {
+        assert_within_sigmas(what, pixel_mean(&shown, 0, keep), visible);
+        assert_within_sigmas(
+            &format!("{what}, hidden"),
+            pixel_mean(&hidden, 0, keep),
+            expected_hidden,
+        );
+    }
+    // The preview hides them too: sky and lamp black, the lamp shaded as its black BSDF.
+    let params = Params::parse::<&str>(&[]).unwrap();
+    let mut eyelight = estimator::create("eyelight", &params, &scene, 37).unwrap();
+    let preview = render(&scene, eyelight.as_mut(), Budget::Passes(1), |_, _| {}).image;
+    for (what, keep, _, _) in &cases[..2] {
+        assert_eq!(pixel_mean(&preview, 0, keep).0, 0.0, "eyelight, {what}");
+    }
 }

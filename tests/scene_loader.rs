@@ -583,7 +583,8 @@ fn path_integrator_depths() {
         desc.integrator,
         IntegratorDesc {
             max_depth: 8,
-            rr_depth: 3
+            rr_depth: 3,
+            hide_emitters: false
         }
     );
     let desc = load_ok("volpath", &with_sphere(r#"<integrator type="volpath"/>"#));
@@ -591,7 +592,8 @@ fn path_integrator_depths() {
         desc.integrator,
         IntegratorDesc {
             max_depth: -1,
-            rr_depth: 5
+            rr_depth: 5,
+            hide_emitters: false
         }
     );
     let desc = load_ok("no_integrator", &with_sphere(""));
@@ -599,7 +601,8 @@ fn path_integrator_depths() {
         desc.integrator,
         IntegratorDesc {
             max_depth: -1,
-            rr_depth: 5
+            rr_depth: 5,
+            hide_emitters: false
         }
     );
 }
@@ -617,7 +620,8 @@ fn moment_wraps_and_direct_is_two_segments() {
         desc.integrator,
         IntegratorDesc {
             max_depth: 3,
-            rr_depth: 5
+            rr_depth: 5,
+            hide_emitters: false
         }
     );
     let desc = load_ok("direct", &with_sphere(r#"<integrator type="direct"/>"#));
@@ -625,7 +629,8 @@ fn moment_wraps_and_direct_is_two_segments() {
         desc.integrator,
         IntegratorDesc {
             max_depth: 2,
-            rr_depth: 5
+            rr_depth: 5,
+            hide_emitters: false
         }
     );
     let (message, _) = load_err(
@@ -633,6 +638,34 @@ fn moment_wraps_and_direct_is_two_segments() {
         &with_sphere(r#"<integrator type="moment"/>"#),
     );
     assert!(message.contains("nested"), "{message}");
+}
+
+#[test]
+fn hide_emitters_is_read_from_path_and_direct() {
+    for kind in ["path", "volpath", "direct"] {
+        let desc = load_ok(
+            &format!("hide_{kind}"),
+            &with_sphere(&format!(
+                r#"<integrator type="{kind}"><boolean name="hide_emitters" value="true"/></integrator>"#
+            )),
+        );
+        assert!(desc.integrator.hide_emitters, "{kind}");
+    }
+    // Through a wrapper too; false is the default.
+    let desc = load_ok(
+        "hide_moment",
+        &with_sphere(
+            r#"<integrator type="moment"><integrator type="path">
+                 <boolean name="hide_emitters" value="true"/></integrator></integrator>"#,
+        ),
+    );
+    assert!(desc.integrator.hide_emitters);
+    let text = with_sphere(
+        r#"<integrator type="path">
+             <integer name="hide_emitters" value="1"/></integrator>"#,
+    );
+    let message = load_err_at("hide_not_boolean", &text, line_of(&text, "hide_emitters"));
+    assert!(message.contains("hide_emitters"), "{message}");
 }
 
 #[test]

@@ -1,7 +1,8 @@
 //! `eyelight`: a preview, not a light-transport estimate. Emitted radiance where the camera
 //! sees an emitter, otherwise the surface's diffuse albedo × |cos θ| between the ray and the
 //! shading normal (0.5 grey for non-diffuse BSDFs). Rays pass through `null` surfaces.
-//! A miss shows the constant environment emitter, if the scene has one, else black.
+//! A miss shows the constant environment emitter, if the scene has one, else black. Under
+//! the scene's `hide_emitters` neither shows: an emitter is shaded as the surface it is.
 
 use super::camera_pass::{CameraEstimator, CameraSampleFn};
 use crate::error::Result;
@@ -18,6 +19,7 @@ pub type EyeLight = CameraEstimator<Shade>;
 
 /// Makes `eyelight` for `scene`; an error when its film does not fit in memory.
 pub fn new(scene: &Scene, seed: u64) -> Result<EyeLight> {
+    let hide_emitters = scene.description.integrator.hide_emitters;
     let background = scene
         .description
         .emitters
@@ -27,12 +29,26 @@ pub fn new(scene: &Scene, seed: u64) -> Result<EyeLight> {
             _ => Rgb::BLACK,
         })
         .fold(Rgb::BLACK, |a, b| a + b);
-    CameraEstimator::new("eyelight", scene, seed, Shade { background })
+    let background = if hide_emitters {
+        Rgb::BLACK
+    } else {
+        background
+    };
+    CameraEstimator::new(
+        "eyelight",
+        scene,
+        seed,
+        Shade {
+            background,
+            hide_emitters,
+        },
+    )
 }
 
 /// The preview shading of one camera ray.
 pub struct Shade {
     background: Rgb,
+    hide_emitters: bool,
 }
 
 impl CameraSampleFn for Shade {
@@ -52,6 +68,7 @@ impl CameraSampleFn for Shade {
             if let Some(EmitterDesc::Area { radiance, .. }) =
                 shape.emitter.map(|e| &scene.description.emitters[e])
                 && hit.ng.dot(toward_eye) > 0.0
+                && !self.hide_emitters
             {
                 return (*radiance, crossing as u64 + 1);
             }

@@ -40,14 +40,21 @@ pub struct PtSettings {
     pub max_depth: Option<u32>,
     /// Depth from which Russian roulette may end a path.
     pub rr_depth: u32,
+    /// Emitters the camera sees are left out, as Mitsuba 3.9's `hide_emitters` does it:
+    /// the emission of the surface a camera ray hits first, and the environment for paths
+    /// that escape having crossed nothing but `null` surfaces. Emitting surfaces seen
+    /// through a `null` surface, anything seen in a mirror, and all light reflected stay.
+    pub hide_emitters: bool,
 }
 
 impl PtSettings {
-    /// Reads `max_depth` and `rr_depth`, defaulting to the scene's integrator element.
+    /// Reads `max_depth`, `rr_depth` and `hide_emitters`, defaulting to the scene's
+    /// integrator element.
     pub fn from_params(params: &Params, scene: &Scene) -> Result<PtSettings> {
         let integrator = &scene.description.integrator;
         let max_depth: i64 = params.get("max_depth", integrator.max_depth as i64)?;
         let rr_depth: u32 = params.get("rr_depth", integrator.rr_depth)?;
+        let hide_emitters: bool = params.get("hide_emitters", integrator.hide_emitters)?;
         // The same bounds as the scene's <integrator> (Mitsuba's).
         if max_depth < -1 {
             return Err(Error::usage(format!(
@@ -65,6 +72,7 @@ impl PtSettings {
         Ok(PtSettings {
             max_depth,
             rr_depth,
+            hide_emitters,
         })
     }
 }
@@ -85,6 +93,12 @@ pub struct PathSample {
 /// What the next vertex needs to weight emission found by the BSDF-sampled ray.
 #[derive(Clone, Copy)]
 struct PreviousVertex {
+    /// Emission of a surface this ray hits counts (false only for a camera ray under
+    /// `hide_emitters`).
+    shows_emitters: bool,
+    /// The environment counts if this ray escapes (under `hide_emitters`, false until the
+    /// path has scattered at a surface that is not `null`).
+    shows_environment: bool,
     /// Where the ray started (for the light's solid-angle density).
     p: Vec3,
     /// Solid-angle density of the BSDF sample.
@@ -168,6 +182,8 @@ impl CameraSampleFn for PathSample {
         // refraction puts into the throughput back out (Mitsuba 3's rule).
         let mut eta = 1.0f32;
         let mut prev = PreviousVertex {
+            shows_emitters: !self.settings.hide_emitters,
+            shows_environment: !self.settings.hide_emitters,
             p: ray.o,
             bsdf_pdf: 1.0,
             specular: true,
@@ -178,6 +194,9 @@ impl CameraSampleFn for PathSample {
         loop {
             rays += 1;
             let Some(si) = scene.geometry.intersect(&ray) else {
+                if !prev.shows_environment {
+                    break;
+                }
                 // The ray escaped: lights at infinity.
                 let towards_light = ray.d.normalize();
                 let point = LightPoint::direction(towards_light);
@@ -191,7 +210,9 @@ impl CameraSampleFn for PathSample {
             let wo_world = -ray.d.normalize();
 
             // Emission from the surface hit (a path of depth + 1 segments).
-            if let Some(light) = scene.lights.light_of_shape(si.shape as usize) {
+            if let Some(light) = scene.lights.light_of_shape(si.shape as usize)
+                && prev.shows_emitters
+            {
                 let point = LightPoint::from(&si);
                 let le = scene.lights.get(light).le(&point, wo_world);
                 if !le.is_black() {
@@ -224,6 +245,8 @@ impl CameraSampleFn for PathSample {
             throughput *= bs.weight;
             eta *= bs.eta;
             prev = PreviousVertex {
+                shows_emitters: true,
+                shows_environment: prev.shows_environment || !bsdf.is_null(),
                 p: si.p,
                 bsdf_pdf: bs.pdf,
                 specular: bs.delta,

@@ -49,6 +49,10 @@ pub struct IntegratorDesc {
     pub max_depth: i32,
     /// Depth from which Russian roulette starts (Mitsuba default 5).
     pub rr_depth: u32,
+    /// Mitsuba's `hide_emitters`: emitters the camera sees first (the environment where a
+    /// camera ray escapes) contribute nothing; seen through a `null` surface, in a mirror or
+    /// by their light, they do.
+    pub hide_emitters: bool,
 }
 
 impl Default for IntegratorDesc {
@@ -56,6 +60,7 @@ impl Default for IntegratorDesc {
         IntegratorDesc {
             max_depth: -1,
             rr_depth: 5,
+            hide_emitters: false,
         }
     }
 }

@@ -1,4 +1,5 @@
-//! `<integrator>`: only the path-length settings are read; mltbench chooses the estimator.
+//! `<integrator>`: only the path-length settings and `hide_emitters` are read; mltbench
+//! chooses the estimator.
 
 use super::Builder;
 use super::values::Props;
@@ -29,8 +30,10 @@ impl Builder<'_> {
         let desc = match kind {
             k if PATH_LIKE.contains(&k) => {
                 props.ignore(&["samples_per_pass", "timeout"]);
-                hide_emitters(&props)?;
-                depths(&props)?
+                IntegratorDesc {
+                    hide_emitters: hide_emitters(&props)?,
+                    ..depths(&props)?
+                }
             }
             // Direct illumination: emitters seen directly plus one bounce (Mitsuba's
             // `direct` has no depth parameters).
@@ -41,9 +44,9 @@ impl Builder<'_> {
                     "shading_samples",
                     "timeout",
                 ]);
-                hide_emitters(&props)?;
                 IntegratorDesc {
                     max_depth: 2,
+                    hide_emitters: hide_emitters(&props)?,
                     ..IntegratorDesc::default()
                 }
             }
@@ -128,15 +131,11 @@ fn depths(props: &Props) -> Result<IntegratorDesc> {
     Ok(IntegratorDesc {
         max_depth,
         rr_depth,
+        hide_emitters: false,
     })
 }
 
-fn hide_emitters(props: &Props) -> Result<()> {
-    if props.boolean("hide_emitters")?.unwrap_or(false) {
-        return Err(props.tree().error(
-            props.elem_of("hide_emitters"),
-            "hide_emitters=true is not supported yet",
-        ));
-    }
-    Ok(())
+/// `hide_emitters` (default false).
+fn hide_emitters(props: &Props) -> Result<bool> {
+    Ok(props.boolean("hide_emitters")?.unwrap_or(false))
 }
