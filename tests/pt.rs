@@ -678,7 +678,9 @@ fn hide_emitters_removes_only_what_camera_rays_find() {
                     .is_none()
             })
     };
-    let cases: [(&str, &dyn Fn(u32, u32) -> bool, f64, f64); 5] = [
+    // (what, which pixels, radiance shown, radiance with hide_emitters)
+    type Case<'a> = (&'a str, &'a dyn Fn(u32, u32) -> bool, f64, f64);
+    let cases: [Case; 5] = [
         ("sky seen directly", &sky, 1.5, 0.0),
         ("lamp seen directly", &sees(0), 3.0, 0.0),
         // Mitsuba 3.9 (llvm_ad_rgb) renders these two the same way: a lamp through a null
