@@ -25,6 +25,10 @@
 //! depend on it. `generate_ray` and `project` are the chief ray (through the lens centre):
 //! exact for a pinhole, and for a thin lens where points on the focus plane land.
 //!
+//! A crop window (`crop_offset_x` … on the film) keeps the whole film's projection and
+//! renders part of it: raster positions, `width` and `height` are the window's, and the
+//! image area A below is the window's part of the plane (Mitsuba 3 does the same).
+//!
 //! Light tracing: `importance_from` (We), `pdf_direction_from` and `pdf_lens_position` are
 //! the sensor response of a ray leaving a camera point (the pinhole or a lens point) and the
 //! densities with which `sample_ray` produces its direction and origin; `importance` and
@@ -48,15 +52,21 @@ use crate::scene::{FovAxis, SensorDesc};
 #[derive(Clone, Debug)]
 pub struct Camera {
     to_world: crate::math::Transform,
+    /// The rendered window's size in pixels.
     width: u32,
     height: u32,
+    /// The whole film's size, and the window's top-left pixel on it.
+    film_width: u32,
+    film_height: u32,
+    offset: Vec2,
     /// tan(fov_x / 2): the half-width of the image on the camera-space plane z = 1.
     tan_half_x: f32,
     /// width / height.
     aspect: f32,
     near_clip: f32,
     far_clip: f32,
-    /// Area of the image on the camera-space plane z = 1: (2 tan(fov_x / 2))² / aspect.
+    /// Area of the window on the camera-space plane z = 1: (2 tan(fov_x / 2))² / aspect
+    /// times the window's share of the film's pixels.
     plane_area: f32,
     /// The pinhole in world space.
     position: Vec3,
@@ -112,17 +122,23 @@ impl Camera {
     /// a `to_world` without scaling. Directions are renormalised anyway, so a `to_world`
     /// that is orthonormal up to rounding is harmless.
     pub fn new(sensor: &SensorDesc) -> Camera {
-        let width = sensor.film.width.max(1);
-        let height = sensor.film.height.max(1);
-        let aspect = width as f64 / height as f64;
+        let film_width = sensor.film.width.max(1);
+        let film_height = sensor.film.height.max(1);
+        let window = sensor.film.window();
+        let (width, height) = (window.width.max(1), window.height.max(1));
+        let aspect = film_width as f64 / film_height as f64;
         let fov_x = horizontal_fov_degrees(sensor.fov_degrees as f64, sensor.fov_axis, aspect);
         let tan_half_x = (0.5 * fov_x).to_radians().tan();
-        let plane_area = (2.0 * tan_half_x) * (2.0 * tan_half_x) / aspect;
+        let share = (width as f64 * height as f64) / (film_width as f64 * film_height as f64);
+        let plane_area = (2.0 * tan_half_x) * (2.0 * tan_half_x) / aspect * share;
         let to_world = sensor.to_world;
         Camera {
             to_world,
             width,
             height,
+            film_width,
+            film_height,
+            offset: Vec2::new(window.x as f32, window.y as f32),
             tan_half_x: tan_half_x as f32,
             aspect: aspect as f32,
             near_clip: sensor.near_clip,
@@ -174,8 +190,8 @@ impl Camera {
 
     /// The camera-space direction (not normalised, z = 1) through raster position `raster`.
     fn camera_direction(&self, raster: Vec2) -> Vec3 {
-        let u = raster.x / self.width as f32;
-        let v = raster.y / self.height as f32;
+        let u = (raster.x + self.offset.x) / self.film_width as f32;
+        let v = (raster.y + self.offset.y) / self.film_height as f32;
         Vec3::new(
             (1.0 - 2.0 * u) * self.tan_half_x,
             (1.0 - 2.0 * v) * self.tan_half_x / self.aspect,
@@ -252,15 +268,17 @@ impl Camera {
     }
 
     /// The raster position of the pinhole projection of camera-space point `q` (q.z > 0),
-    /// or None outside the image.
+    /// or None outside the rendered window (bounds inclusive).
     fn raster_of(&self, q: Vec3) -> Option<Vec2> {
         let s = 0.5 / (q.z * self.tan_half_x);
         let u = 0.5 - q.x * s;
         let v = 0.5 - self.aspect * q.y * s;
-        if !((0.0..=1.0).contains(&u) && (0.0..=1.0).contains(&v)) {
-            return None;
-        }
-        Some(Vec2::new(u * self.width as f32, v * self.height as f32))
+        let raster = Vec2::new(
+            u * self.film_width as f32 - self.offset.x,
+            v * self.film_height as f32 - self.offset.y,
+        );
+        let size = Vec2::new(self.width as f32, self.height as f32);
+        (raster.cmpge(Vec2::ZERO).all() && raster.cmple(size).all()).then_some(raster)
     }
 
     /// The importance We(ω) of a ray leaving the pinhole (or the lens centre) in unit
@@ -351,10 +369,8 @@ impl Camera {
     /// the image (bounds inclusive, as in Mitsuba 3).
     fn plane_cos_theta(&self, direction: Vec3) -> Option<f32> {
         let d = self.forward_camera_direction(direction)?;
-        let x = d.x / d.z;
-        let y = d.y / d.z;
-        let half_h = self.tan_half_x / self.aspect;
-        (x.abs() <= self.tan_half_x && y.abs() <= half_h).then_some(d.z)
+        self.raster_of(d / d.z)?;
+        Some(d.z)
     }
 
     /// The camera end of a connection from world point `p` to a pinhole: None when `p` is

@@ -9,7 +9,7 @@ use camera_support::{RECORDED_SENSORS, assert_matches_recorded_ray, lookat, tria
 use glam::{Mat4, Vec2, Vec3};
 use mltbench::camera::{Camera, horizontal_fov_degrees, raster_in_pixel};
 use mltbench::math::Transform;
-use mltbench::scene::{FilmDesc, FilterDesc, FovAxis, SensorDesc};
+use mltbench::scene::{CropWindow, FilmDesc, FilterDesc, FovAxis, SensorDesc};
 use rand::{RngExt, SeedableRng};
 use rand_xoshiro::Xoshiro256PlusPlus;
 
@@ -25,6 +25,7 @@ fn sensor(to_world: Transform, fov: f32, axis: FovAxis, width: u32, height: u32)
             width,
             height,
             filter: FilterDesc::Box,
+            crop: None,
         },
         sample_count: 1,
     }
@@ -244,23 +245,14 @@ fn project_rejects_points_outside_the_view() {
     assert!(cam.project(Vec3::new(0.0, 0.0, 0.02)).is_some());
 }
 
-#[test]
-fn direction_pdf_matches_the_solid_angle_of_raster_cells() {
-    // Uniform raster sampling gives each of the W·H/cells² cells probability cells²/(W·H);
-    // pdf_direction(centre) · solid angle(cell) must agree. The solid angle is computed from
-    // the cell's corner rays only, independently of the cos³ formula.
-    let s = sensor(
-        lookat(Vec3::new(1.0, 2.0, 3.0), Vec3::new(-1.0, 0.0, 0.0), Vec3::Y),
-        70.0,
-        FovAxis::X,
-        48,
-        30,
-    );
-    let cam = Camera::new(&s);
+/// pdf_direction at each raster cell's centre times the cell's solid angle (from its corner
+/// rays only, independently of the cos³ formula), against the cell's probability under
+/// uniform raster sampling: (sum over the cells, worst relative error of one cell).
+fn direction_pdf_over_cells(cam: &Camera) -> (f64, f64) {
     let cell = 0.5f32;
     let mut total = 0.0f64;
     let mut worst = 0.0f64;
-    let (w, h) = (s.film.width as f32, s.film.height as f32);
+    let (w, h) = (cam.width() as f32, cam.height() as f32);
     let mut y = 0.0;
     while y < h {
         let mut x = 0.0;
@@ -276,6 +268,22 @@ fn direction_pdf_matches_the_solid_angle_of_raster_cells() {
         }
         y += cell;
     }
+    (total, worst)
+}
+
+#[test]
+fn direction_pdf_matches_the_solid_angle_of_raster_cells() {
+    // Uniform raster sampling gives each of the W·H/cells² cells probability cells²/(W·H);
+    // pdf_direction(centre) · solid angle(cell) must agree.
+    let s = sensor(
+        lookat(Vec3::new(1.0, 2.0, 3.0), Vec3::new(-1.0, 0.0, 0.0), Vec3::Y),
+        70.0,
+        FovAxis::X,
+        48,
+        30,
+    );
+    let cam = Camera::new(&s);
+    let (total, worst) = direction_pdf_over_cells(&cam);
     assert!(worst < 1e-3, "worst relative error {worst}");
     assert!((total - 1.0).abs() < 1e-4, "total {total}");
     // We = pdf / cos θ for the pinhole, and 0 outside the image.
@@ -429,4 +437,57 @@ fn matches_rays_recorded_from_mitsuba_3() {
         let what = format!("case {case} raster ({x}, {y})");
         assert_matches_recorded_ray(&ray, o, d, maxt, &what);
     }
+}
+
+#[test]
+fn a_crop_window_renders_part_of_the_same_projection() {
+    // Mitsuba's crop_offset/crop_width/crop_height: the rays of the window's pixels are the
+    // full film's rays at the offset pixels; the direction density and importance are
+    // normalised over the window alone.
+    let full = sensor(
+        lookat(Vec3::new(1.0, 2.0, 3.0), Vec3::new(-1.0, 0.0, 0.0), Vec3::Y),
+        70.0,
+        FovAxis::X,
+        48,
+        30,
+    );
+    let mut cropped = full.clone();
+    cropped.film.crop = Some(CropWindow {
+        x: 10,
+        y: 5,
+        width: 20,
+        height: 12,
+    });
+    let (big, cam) = (Camera::new(&full), Camera::new(&cropped));
+    assert_eq!((cam.width(), cam.height()), (20, 12));
+    let offset = Vec2::new(10.0, 5.0);
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(11);
+    for _ in 0..500 {
+        let raster = Vec2::new(rng.random::<f32>() * 20.0, rng.random::<f32>() * 12.0);
+        let (a, b) = (cam.generate_ray(raster), big.generate_ray(raster + offset));
+        assert_eq!((a.o, a.d, a.t_max), (b.o, b.d, b.t_max));
+        let p = a.at(1.0 + 5.0 * rng.random::<f32>());
+        assert_close(cam.project(p).unwrap(), raster, 2e-3, "cropped round trip");
+        let ratio = cam.pdf_direction(a.d) / big.pdf_direction(a.d);
+        assert!(
+            (ratio - (48.0 * 30.0) / (20.0 * 12.0)).abs() < 1e-5,
+            "{ratio}"
+        );
+    }
+    // Points the full film sees outside the window are outside the cropped image.
+    for raster in [
+        Vec2::new(5.0, 10.0),
+        Vec2::new(40.0, 10.0),
+        Vec2::new(20.0, 2.0),
+    ] {
+        let p = big.generate_ray(raster).at(2.0);
+        assert!(
+            big.project(p).is_some() && cam.project(p).is_none(),
+            "{raster}"
+        );
+        assert_eq!(cam.pdf_direction(big.generate_ray(raster).d), 0.0);
+    }
+    let (total, worst) = direction_pdf_over_cells(&cam);
+    assert!(worst < 1e-3, "worst relative error {worst}");
+    assert!((total - 1.0).abs() < 1e-4, "total {total}");
 }

@@ -40,6 +40,7 @@ fn check_mutant(path: &Path) -> Result<bool, String> {
     let film = &mut desc.sensor.film;
     film.width = film.width.min(RENDER_SIDE);
     film.height = film.height.min(RENDER_SIDE);
+    film.crop = None;
     let built = catch_unwind(AssertUnwindSafe(|| Scene::build(desc)))
         .map_err(|_| "building the scene panicked")?;
     let scene = match built {

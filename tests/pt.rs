@@ -18,7 +18,7 @@ use mltbench::estimator::{self, Params};
 use mltbench::image::Image;
 use mltbench::math::Rgb;
 use mltbench::render::{Budget, render};
-use mltbench::scene::{Scene, mitsuba};
+use mltbench::scene::{CropWindow, Scene, mitsuba};
 
 /// Standard deviations allowed before a test fails.
 const SIGMAS: f64 = 4.0;
@@ -325,6 +325,26 @@ fn floor_irradiance_under_a_rectangle_light_matches_lamberts_formula() {
                 <scale x="0.23" y="0.19"/><rotate x="1" angle="90"/><translate y="0.99"/>
             </transform>"#,
         Path::new("test-scene.xml"),
+        None,
+    );
+}
+
+/// A crop window renders its part of the film: the cropped image's pixels against
+/// Lambert's formula over the full film's pixels they stand for.
+#[test]
+fn a_crop_window_shows_the_floor_where_the_full_film_does() {
+    assert_floor_under_the_cbox_light(
+        r#"<shape type="rectangle">
+            <transform name="to_world">
+                <scale x="0.23" y="0.19"/><rotate x="1" angle="90"/><translate y="0.99"/>
+            </transform>"#,
+        Path::new("test-scene.xml"),
+        Some(CropWindow {
+            x: 3,
+            y: 4,
+            width: 10,
+            height: 11,
+        }),
     );
 }
 
@@ -368,6 +388,7 @@ fn assert_floor_under_the_cbox_light_as_obj(name: &str, normals_and_faces: &str)
     assert_floor_under_the_cbox_light(
         r#"<shape type="obj"><string name="filename" value="light.obj"/>"#,
         &dir.join("scene.xml"),
+        None,
     );
 }
 
@@ -430,8 +451,14 @@ fn a_scene_far_from_the_origin_is_lit_as_at_the_origin() {
 
 /// Direct lighting only, from the shape opened by `light_shape` (the Cornell box light's
 /// rectangle, emitting downwards), on the floor: pixel means over 16 runs against
-/// ρ/π · Le · E_unit (Lambert's formula), within `SIGMAS`.
-fn assert_floor_under_the_cbox_light(light_shape: &str, scene_path: &Path) {
+/// ρ/π · Le · E_unit (Lambert's formula), within `SIGMAS`. With `crop`, the film renders
+/// only that window, and each of its pixels is held to the formula for the full film's
+/// pixel it stands for (the expectation comes from the uncropped camera).
+fn assert_floor_under_the_cbox_light(
+    light_shape: &str,
+    scene_path: &Path,
+    crop: Option<CropWindow>,
+) {
     let (rho, le) = (0.6f64, [18.387f64, 13.9873, 6.75357]);
     let xml = format!(
         r#"<scene version="3.0.0">
@@ -447,7 +474,15 @@ fn assert_floor_under_the_cbox_light(light_shape: &str, scene_path: &Path) {
         floor = floor(0.6)
     );
     let desc = mitsuba::load_str(&xml, scene_path).expect("scene loads");
-    let scene = Scene::build(desc).expect("scene builds");
+    let full = Scene::build(desc.clone()).expect("scene builds");
+    let mut cropped = desc;
+    cropped.sensor.film.crop = crop;
+    let scene = Scene::build(cropped).expect("cropped scene builds");
+    let window = scene.description.sensor.film.window();
+    assert_eq!(
+        (scene.width(), scene.height()),
+        (window.width, window.height)
+    );
     let light = [
         Vec3::new(-0.23, 0.99, -0.19),
         Vec3::new(0.23, 0.99, -0.19),
@@ -458,17 +493,30 @@ fn assert_floor_under_the_cbox_light(light_shape: &str, scene_path: &Path) {
     let runs: Vec<Image> = (0..16)
         .map(|k| render_pt(&scene, &[], 16, 100 + k))
         .collect();
-    let pixels = [(8, 8), (4, 4), (12, 5), (3, 12), (8, 14), (13, 13)];
+    assert_eq!(
+        (runs[0].width, runs[0].height),
+        (window.width, window.height)
+    );
+    let pixels: [(u32, u32); 6] = [(8, 8), (4, 4), (12, 5), (3, 12), (8, 14), (13, 13)];
+    let mut checked = 0;
     for (x, y) in pixels {
-        let e = floor_pixel_average(&scene, x, y, |p| polygon_irradiance(p, Vec3::Y, &light));
+        let (Some(cx), Some(cy)) = (x.checked_sub(window.x), y.checked_sub(window.y)) else {
+            continue;
+        };
+        if cx >= window.width || cy >= window.height {
+            continue;
+        }
+        checked += 1;
+        let e = floor_pixel_average(&full, x, y, |p| polygon_irradiance(p, Vec3::Y, &light));
         for (c, le) in le.into_iter().enumerate() {
             assert_within_sigmas(
                 &format!("floor pixel ({x},{y}) channel {c}"),
-                mean_over_runs(&runs, x, y, c),
+                mean_over_runs(&runs, cx, cy, c),
                 rho / std::f64::consts::PI * le * e,
             );
         }
     }
+    assert!(checked >= 4, "{checked} pixels inside the window");
 }
 
 #[test]

@@ -289,7 +289,8 @@ fn perspective_sensor_reads_every_parameter() {
         FilmDesc {
             width: 320,
             height: 200,
-            filter: FilterDesc::Box
+            filter: FilterDesc::Box,
+            crop: None,
         }
     );
 }
@@ -465,7 +466,8 @@ fn film_and_filter_defaults_follow_mitsuba() {
         FilmDesc {
             width: 768,
             height: 576,
-            filter: FilterDesc::Gaussian { stddev: 0.5 }
+            filter: FilterDesc::Gaussian { stddev: 0.5 },
+            crop: None,
         }
     );
     assert_eq!(desc.sensor.sample_count, 4);
@@ -483,9 +485,72 @@ fn film_and_filter_defaults_follow_mitsuba() {
         FilmDesc {
             width: 16,
             height: 576,
-            filter: FilterDesc::Gaussian { stddev: 0.25 }
+            filter: FilterDesc::Gaussian { stddev: 0.25 },
+            crop: None,
         }
     );
+}
+
+#[test]
+fn crop_windows_are_read_and_must_lie_inside_the_film() {
+    let film = |props: &str| {
+        with_sphere(&format!(
+            r#"<sensor type="perspective"><film type="hdrfilm">
+                 <integer name="width" value="64"/><integer name="height" value="48"/>
+{props}
+               </film></sensor>"#
+        ))
+    };
+    let desc = load_ok(
+        "crop_all",
+        &film(
+            r#"<integer name="crop_offset_x" value="10"/><integer name="crop_offset_y" value="4"/>
+               <integer name="crop_width" value="20"/><integer name="crop_height" value="44"/>"#,
+        ),
+    );
+    let window = CropWindow {
+        x: 10,
+        y: 4,
+        width: 20,
+        height: 44,
+    };
+    assert_eq!(desc.sensor.film.crop, Some(window));
+    assert_eq!(desc.sensor.film.window(), window);
+    // Offsets default to 0 and sizes to the film's (Mitsuba's hdrfilm).
+    let desc = load_ok(
+        "crop_width",
+        &film(r#"<integer name="crop_width" value="8"/>"#),
+    );
+    assert_eq!(
+        desc.sensor.film.window(),
+        CropWindow {
+            x: 0,
+            y: 0,
+            width: 8,
+            height: 48
+        }
+    );
+    // Outside the film (an offset without a smaller size included), or empty: the line of
+    // the offending value.
+    for (name, props) in [
+        (
+            "crop_offset_only",
+            r#"<integer name="crop_offset_y" value="1"/>"#,
+        ),
+        (
+            "crop_too_wide",
+            r#"<integer name="crop_offset_x" value="60"/><integer name="crop_width" value="5"/>"#,
+        ),
+        ("crop_empty", r#"<integer name="crop_height" value="0"/>"#),
+        (
+            "crop_negative",
+            r#"<integer name="crop_offset_x" value="-1"/>"#,
+        ),
+    ] {
+        let text = film(props);
+        let message = load_err_at(name, &text, line_of(&text, "crop_"));
+        assert!(message.contains("crop"), "{message}");
+    }
 }
 
 #[test]

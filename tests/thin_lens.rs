@@ -38,6 +38,7 @@ fn sensor(
             width,
             height,
             filter: FilterDesc::Box,
+            crop: None,
         },
         sample_count: 1,
     }

@@ -106,7 +106,7 @@ impl<S: CameraSampleFn + Send> CameraEstimator<S> {
         let film = &scene.description.sensor.film;
         Ok(CameraEstimator {
             name,
-            film: Film::new(film.width, film.height, film.filter)?,
+            film: Film::new(film.window().width, film.window().height, film.filter)?,
             seed,
             stats: Stats::default(),
             sample,

@@ -121,9 +121,33 @@ pub struct ThinLensDesc {
 /// `<film type="hdrfilm">`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FilmDesc {
+    /// The whole film, which the field of view spans.
     pub width: u32,
     pub height: u32,
     pub filter: FilterDesc,
+    /// The part of it that is rendered (`crop_offset_x` … `crop_height`); `None` = all.
+    pub crop: Option<CropWindow>,
+}
+
+/// A rectangle of a film's pixels, inside the film.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct CropWindow {
+    pub x: u32,
+    pub y: u32,
+    pub width: u32,
+    pub height: u32,
+}
+
+impl FilmDesc {
+    /// The pixels rendered: the crop window, or the whole film.
+    pub fn window(&self) -> CropWindow {
+        self.crop.unwrap_or(CropWindow {
+            x: 0,
+            y: 0,
+            width: self.width,
+            height: self.height,
+        })
+    }
 }
 
 impl Default for FilmDesc {
@@ -132,6 +156,7 @@ impl Default for FilmDesc {
             width: 768,
             height: 576,
             filter: FilterDesc::default(),
+            crop: None,
         }
     }
 }

@@ -53,11 +53,13 @@ impl Scene {
         &self.bsdfs[self.description.shapes[shape as usize].bsdf]
     }
 
+    /// Width of the rendered image: the film's crop window, if it has one.
     pub fn width(&self) -> u32 {
-        self.description.sensor.film.width
+        self.description.sensor.film.window().width
     }
 
+    /// Height of the rendered image (see `width`).
     pub fn height(&self) -> u32 {
-        self.description.sensor.film.height
+        self.description.sensor.film.window().height
     }
 }

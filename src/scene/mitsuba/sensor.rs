@@ -9,7 +9,7 @@ use super::xml::ElemId;
 use crate::error::Result;
 use crate::image::MAX_PIXELS;
 use crate::math::Transform;
-use crate::scene::{FilmDesc, FilterDesc, FovAxis, SensorDesc, ThinLensDesc};
+use crate::scene::{CropWindow, FilmDesc, FilterDesc, FovAxis, SensorDesc, ThinLensDesc};
 
 /// Mitsuba sensors mltbench does not implement.
 const UNSUPPORTED_SENSORS: &[&str] = &[
@@ -212,16 +212,7 @@ impl Builder<'_> {
             "sample_border",
             "compensate",
         ]);
-        for name in [
-            "crop_offset_x",
-            "crop_offset_y",
-            "crop_width",
-            "crop_height",
-        ] {
-            if props.has(name) {
-                return Err(tree.error(props.elem_of(name), format!("{name} is not supported yet")));
-            }
-        }
+        film.crop = crop_window(&props, film.width, film.height)?;
         for (i, object) in props.objects().iter().enumerate() {
             if tree.tag(object.target) == "rfilter" {
                 props.use_object(i);
@@ -406,4 +397,63 @@ pub(super) fn default_sensor(bbox_min: Vec3, bbox_max: Vec3) -> SensorDesc {
     )))
     .unwrap_or(Transform::IDENTITY);
     sensor
+}
+
+/// `crop_offset_x`, `crop_offset_y`, `crop_width`, `crop_height` (Mitsuba 3's `hdrfilm`:
+/// offsets default to 0, sizes to the film's; the window must lie inside the film). `None`
+/// when none is given.
+fn crop_window(props: &Props, width: u32, height: u32) -> Result<Option<CropWindow>> {
+    let names = [
+        "crop_offset_x",
+        "crop_offset_y",
+        "crop_width",
+        "crop_height",
+    ];
+    if !names.iter().any(|name| props.has(name)) {
+        return Ok(None);
+    }
+    let tree = props.tree();
+    let read = |name: &str, default: u32, least: i64| -> Result<u32> {
+        match props.integer(name)? {
+            None => Ok(default),
+            Some(v) if v >= least && v <= MAX_FILM_SIDE => Ok(v as u32),
+            Some(v) => Err(tree.error(
+                props.elem_of(name),
+                format!("{name} must be between {least} and {MAX_FILM_SIDE}, got {v}"),
+            )),
+        }
+    };
+    let window = CropWindow {
+        x: read("crop_offset_x", 0, 0)?,
+        y: read("crop_offset_y", 0, 0)?,
+        width: read("crop_width", width, 1)?,
+        height: read("crop_height", height, 1)?,
+    };
+    for (axis, offset, size, side) in [
+        ("x", window.x, window.width, width),
+        ("y", window.y, window.height, height),
+    ] {
+        if u64::from(offset) + u64::from(size) > u64::from(side) {
+            // Name whichever of the two was written last.
+            let [o, s] = if axis == "x" {
+                ["crop_offset_x", "crop_width"]
+            } else {
+                ["crop_offset_y", "crop_height"]
+            };
+            let at = [o, s]
+                .into_iter()
+                .filter(|name| props.has(name))
+                .max_by_key(|name| tree.elem(props.elem_of(name)).line)
+                .map(|name| props.elem_of(name))
+                .expect("one of them is given");
+            return Err(tree.error(
+                at,
+                format!(
+                    "the crop window leaves the film along {axis}: offset {offset} + size \
+                     {size} > {side}"
+                ),
+            ));
+        }
+    }
+    Ok(Some(window))
 }
