@@ -10,6 +10,7 @@ pub mod experiment;
 pub mod film;
 pub mod geometry;
 pub mod image;
+pub mod interrupt;
 pub mod io;
 pub mod lecture;
 pub mod light;

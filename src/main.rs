@@ -10,7 +10,7 @@ use mltbench::estimator::{self, ESTIMATOR_NAMES, Params};
 use mltbench::experiment::{self, Experiment};
 use mltbench::render::{Budget, render};
 use mltbench::scene::{Scene, mitsuba};
-use mltbench::{Error, Result, io};
+use mltbench::{Error, Result, interrupt, io};
 
 /// mltbench: a research bench for light-transport estimators.
 ///
@@ -159,7 +159,10 @@ fn estimator_help() -> String {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let outcome = match cli.command {
-        Command::Render(args) => run_render(args),
+        Command::Render(args) => match run_render(args) {
+            Ok(true) => return ExitCode::from(interrupt::EXIT_STATUS),
+            other => other.map(|_| ()),
+        },
         Command::Run(args) => run_experiment(args),
         Command::List => list_experiments(),
         Command::Report(args) => report_experiment(args),
@@ -175,7 +178,8 @@ fn main() -> ExitCode {
     }
 }
 
-fn run_render(args: RenderArgs) -> Result<()> {
+/// `render`; Ok(true) when a stop request cut it short (the passes done are written).
+fn run_render(args: RenderArgs) -> Result<bool> {
     let params = Params::parse(&args.common.set)?;
     if let Some(t) = args.time
         && !(t.is_finite() && t > 0.0)
@@ -212,6 +216,19 @@ fn run_render(args: RenderArgs) -> Result<()> {
     let mut estimator =
         estimator::create(&args.common.estimator, &params, &scene, args.common.seed)?;
 
+    // From here on Ctrl-C (or SIGTERM) stops after the pass in progress and writes it.
+    interrupt::install();
+    eprintln!(
+        "{}: rendering {} × {} pixels{}; Ctrl-C stops after the current pass and writes the \
+         image so far",
+        args.common.estimator,
+        scene.width(),
+        scene.height(),
+        match budget {
+            Budget::Passes(n) => format!(", {n} passes"),
+            Budget::Seconds(s) => format!(" for {s} s"),
+        }
+    );
     let bar = progress_bar(budget);
     let result = pool.install(|| {
         render(
@@ -246,7 +263,13 @@ fn run_render(args: RenderArgs) -> Result<()> {
         output.display(),
         preview.display()
     );
-    Ok(())
+    if result.interrupted {
+        eprintln!(
+            "{}: interrupted: the image holds the {} passes done",
+            args.common.estimator, stats.passes
+        );
+    }
+    Ok(result.interrupted)
 }
 
 /// The most worker threads `--threads` may ask for.

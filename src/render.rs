@@ -20,10 +20,14 @@ pub struct RenderOutput {
     pub image: Image,
     pub stats: Stats,
     pub seconds: f64,
+    /// The budget was cut short by a stop request (`interrupt`): the image holds the passes
+    /// done (`stats.passes`, at least one).
+    pub interrupted: bool,
 }
 
-/// Runs `estimator` on `scene` until `budget` is spent. `on_pass(done, elapsed)` is called
-/// after every pass (for progress bars).
+/// Runs `estimator` on `scene` until `budget` is spent, or, after at least one pass, until a
+/// stop is requested (`interrupt`). `on_pass(done, elapsed)` is called after every pass (for
+/// progress bars).
 pub fn render(
     scene: &Scene,
     estimator: &mut dyn Estimator,
@@ -32,12 +36,17 @@ pub fn render(
 ) -> RenderOutput {
     let start = Instant::now();
     let mut pass = 0u32;
+    let mut interrupted = false;
     loop {
         let done = match budget {
             Budget::Passes(n) => pass >= n,
             Budget::Seconds(s) => pass > 0 && start.elapsed().as_secs_f64() >= s,
         };
         if done {
+            break;
+        }
+        if pass > 0 && crate::interrupt::requested() {
+            interrupted = true;
             break;
         }
         estimator.run_pass(scene, pass);
@@ -48,5 +57,6 @@ pub fn render(
         image: estimator.image(),
         stats: estimator.stats(),
         seconds: start.elapsed().as_secs_f64(),
+        interrupted,
     }
 }
