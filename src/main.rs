@@ -166,7 +166,10 @@ fn main() -> ExitCode {
         Command::Run(args) => run_experiment(args),
         Command::List => list_experiments(),
         Command::Report(args) => report_experiment(args),
-        Command::Reference(args) => render_reference(args),
+        Command::Reference(args) => match render_reference(args) {
+            Ok(true) => return ExitCode::from(interrupt::EXIT_STATUS),
+            other => other.map(|_| ()),
+        },
         Command::Compare(args) => compare(args),
     };
     match outcome {
@@ -401,7 +404,9 @@ fn report_experiment(args: ReportArgs) -> Result<()> {
     Ok(())
 }
 
-fn render_reference(args: ReferenceArgs) -> Result<()> {
+/// `reference`; Ok(true) when a stop request cut it short (the equal halves done are
+/// written).
+fn render_reference(args: ReferenceArgs) -> Result<bool> {
     Params::parse(&args.common.set)?; // rejects a malformed --set before any rendering
     estimator::check_name(&args.common.estimator)?;
     let budget = match (args.spp, args.time) {
@@ -431,6 +436,14 @@ fn render_reference(args: ReferenceArgs) -> Result<()> {
     io::outputs::check_not_inputs(outputs, &description.files_read)?;
     let scene = Scene::build(description)?;
     let pool = thread_pool(args.common.threads)?;
+    // From here on Ctrl-C (or SIGTERM) stops both halves after the passes in progress.
+    interrupt::install();
+    eprintln!(
+        "reference: rendering {} × {} pixels in two halves; Ctrl-C stops after the current \
+         passes and writes the reference so far",
+        scene.width(),
+        scene.height()
+    );
     let bar = experiment_bar();
     let rendered = pool.install(|| {
         experiment::reference::render_reference(
@@ -453,7 +466,14 @@ fn render_reference(args: ReferenceArgs) -> Result<()> {
         info.noise_relmse.unwrap_or(f64::NAN),
         output.display()
     );
-    Ok(())
+    let interrupted = interrupt::requested();
+    if interrupted {
+        eprintln!(
+            "reference: stopped on request: it holds the {} passes done (two equal halves)",
+            info.passes
+        );
+    }
+    Ok(interrupted)
 }
 
 fn compare(args: CompareArgs) -> Result<()> {

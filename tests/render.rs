@@ -499,44 +499,97 @@ fn cli_prints_each_warning_once() {
     assert!(stderr.contains("scene.xml:2"), "{stderr}");
 }
 
-/// Ctrl-C (SIGINT) during `render` stops after the pass in progress and writes the passes
-/// done, with exit status 130; the image is a valid EXR of the film's size.
-#[test]
-fn cli_writes_the_passes_done_when_interrupted() {
-    use std::io::{BufRead, BufReader};
-    let dir = temp_dir("interrupted");
-    let scene = scenes_dir().join("cbox.xml");
+/// Starts `mltbench ARGS` in `dir`, waits until it announces that Ctrl-C is handled, sends
+/// SIGINT, and returns (exit status, the rest of its standard error).
+fn interrupt_after_announcement(dir: &Path, args: &[&str]) -> (Option<i32>, String) {
+    use std::io::{BufRead, BufReader, Read};
     let mut child = Command::new(env!("CARGO_BIN_EXE_mltbench"))
-        .args(["render", scene.to_str().unwrap(), "--estimator", "pt"])
-        .args(["-D", "res=32", "--spp", "100000000", "--threads", "1"])
-        .args(["-o", "cut.exr"])
-        .current_dir(&dir)
+        .args(args)
+        .current_dir(dir)
         .stderr(std::process::Stdio::piped())
         .spawn()
         .unwrap();
-    // The handler is in place once the render announces itself.
     let mut stderr = BufReader::new(child.stderr.take().unwrap());
     let mut line = String::new();
     while !line.contains("Ctrl-C stops") {
         line.clear();
-        assert!(
-            stderr.read_line(&mut line).unwrap() > 0,
-            "render ended early"
-        );
+        assert!(stderr.read_line(&mut line).unwrap() > 0, "ended early");
     }
-    // SAFETY: sends SIGINT to the child process, which is still running (it cannot finish
-    // 10^8 passes).
+    // SAFETY: sends SIGINT to the child, still running (its budget is 10^8 passes).
     assert_eq!(
         unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) },
         0
     );
     let mut rest = String::new();
-    std::io::Read::read_to_string(&mut stderr, &mut rest).unwrap();
-    let status = child.wait().unwrap();
-    assert_eq!(status.code(), Some(130), "{rest}");
+    stderr.read_to_string(&mut rest).unwrap();
+    (child.wait().unwrap().code(), rest)
+}
+
+/// Ctrl-C (SIGINT) during `render` stops after the pass in progress and writes the passes
+/// done, with exit status 130; the image is a valid EXR of the film's size.
+#[test]
+fn cli_writes_the_passes_done_when_interrupted() {
+    let dir = temp_dir("interrupted");
+    let scene = scenes_dir().join("cbox.xml");
+    let (status, rest) = interrupt_after_announcement(
+        &dir,
+        &[
+            "render",
+            scene.to_str().unwrap(),
+            "--estimator",
+            "pt",
+            "-D",
+            "res=32",
+            "--spp",
+            "100000000",
+            "--threads",
+            "1",
+            "-o",
+            "cut.exr",
+        ],
+    );
+    assert_eq!(status, Some(130), "{rest}");
     assert!(rest.contains("interrupted: the image holds the"), "{rest}");
     let image = mltbench::io::exr::read_exr(&dir.join("cut.exr")).unwrap();
     assert_eq!((image.width, image.height), (32, 32));
     assert!(image.pixels.iter().any(|p| p.max_component() > 0.0));
     assert!(dir.join("cut.png").exists());
+}
+
+/// The same for `reference`: both halves stop at the same pass, and the reference, its
+/// noise estimate and its preview are written.
+#[test]
+fn cli_reference_keeps_two_equal_halves_when_interrupted() {
+    let dir = temp_dir("interrupted_reference");
+    let scene = scenes_dir().join("cbox.xml");
+    let (status, rest) = interrupt_after_announcement(
+        &dir,
+        &[
+            "reference",
+            scene.to_str().unwrap(),
+            "--estimator",
+            "pt",
+            "-D",
+            "res=32",
+            "--spp",
+            "100000000",
+            "--threads",
+            "1",
+            "-o",
+            "ref.exr",
+        ],
+    );
+    assert_eq!(status, Some(130), "{rest}");
+    assert!(rest.contains("stopped on request"), "{rest}");
+    let reference = mltbench::experiment::reference::load(&dir.join("ref.exr")).unwrap();
+    assert_eq!((reference.image.width, reference.image.height), (32, 32));
+    let info = &reference.info;
+    assert!(
+        info.passes >= 2 && info.passes.is_multiple_of(2),
+        "{} passes",
+        info.passes
+    );
+    assert_eq!(info.samples, info.passes * 32 * 32);
+    assert!(info.noise_relmse.is_some_and(|n| n > 0.0 && n.is_finite()));
+    assert!(dir.join("ref.png").exists());
 }

@@ -9,6 +9,7 @@
 //! reference is rendered.
 
 use std::path::{Path, PathBuf};
+use std::time::Instant;
 
 use serde::{Deserialize, Serialize};
 
@@ -19,7 +20,7 @@ use crate::image::Image;
 use crate::io::atomic::write_file_atomically;
 use crate::io::exr::{read_exr, write_exr};
 use crate::io::png::write_png_preview;
-use crate::render::{Budget, render};
+use crate::render::Budget;
 use crate::sampler::independent::hash_words;
 use crate::scene::Scene;
 
@@ -53,7 +54,11 @@ pub struct Reference {
 const HALF_SEED_TAG: u64 = 0x5EF0_5EF0;
 
 /// Renders `scene` with `estimator` as two independent halves of `budget` and averages them
-/// (weighted by their samples). `on_pass(half, passes done)` reports progress.
+/// (weighted by their samples). The halves take their passes in turn, so that both always
+/// hold the same number: a time budget gives each half of it, and a stop request
+/// (`interrupt`, after at least one pass each) leaves two equal halves of the passes done.
+/// Each half's image is the one it would give alone (its passes do not depend on the
+/// other's). `on_pass(half, passes done)` reports progress.
 pub fn render_reference(
     scene: &Scene,
     estimator_name: &str,
@@ -62,21 +67,41 @@ pub fn render_reference(
     seed: u64,
     mut on_pass: impl FnMut(usize, u32),
 ) -> Result<(Image, ReferenceInfo)> {
-    let half_budget = match budget {
-        Budget::Passes(p) => Budget::Passes(p.div_ceil(2)),
-        Budget::Seconds(s) => Budget::Seconds(s / 2.0),
-    };
-    let mut halves = Vec::new();
-    let (mut passes, mut samples, mut seconds) = (0u64, 0u64, 0f64);
-    for half in 0..2 {
+    let mut estimators = Vec::new();
+    for half in 0..2u64 {
         let params = Params::parse(params)?;
-        let half_seed = hash_words(&[seed, HALF_SEED_TAG, half as u64]);
-        let mut est = estimator::create(estimator_name, &params, scene, half_seed)?;
-        let out = render(scene, est.as_mut(), half_budget, |p, _| on_pass(half, p));
-        passes += out.stats.passes;
-        samples += out.stats.samples;
-        seconds += out.seconds;
-        halves.push((out.image, out.stats.samples.max(1) as f64));
+        let half_seed = hash_words(&[seed, HALF_SEED_TAG, half]);
+        estimators.push(estimator::create(
+            estimator_name,
+            &params,
+            scene,
+            half_seed,
+        )?);
+    }
+    let start = Instant::now();
+    let mut pass = 0u32;
+    loop {
+        let done = match budget {
+            Budget::Passes(p) => pass >= p.div_ceil(2),
+            Budget::Seconds(s) => pass > 0 && start.elapsed().as_secs_f64() >= s,
+        };
+        if done || (pass > 0 && crate::interrupt::requested()) {
+            break;
+        }
+        for (half, est) in estimators.iter_mut().enumerate() {
+            est.run_pass(scene, pass);
+            on_pass(half, pass + 1);
+        }
+        pass += 1;
+    }
+    let seconds = start.elapsed().as_secs_f64();
+    let (mut passes, mut samples) = (0u64, 0u64);
+    let mut halves = Vec::new();
+    for est in &estimators {
+        let stats = est.stats();
+        passes += stats.passes;
+        samples += stats.samples;
+        halves.push((est.image(), stats.samples.max(1) as f64));
     }
     let (a, wa) = &halves[0];
     let (b, wb) = &halves[1];
