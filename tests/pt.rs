@@ -316,17 +316,17 @@ fn polygon_irradiance(p: Vec3, n: Vec3, vertices: &[Vec3]) -> f64 {
     0.5 * sum.abs()
 }
 
+/// The Cornell box light's rectangle, emitting downwards (the `<shape>` left open for its
+/// BSDF and emitter).
+const CBOX_LIGHT_RECTANGLE: &str = r#"<shape type="rectangle">
+    <transform name="to_world">
+        <scale x="0.23" y="0.19"/><rotate x="1" angle="90"/><translate y="0.99"/>
+    </transform>"#;
+
 #[test]
 fn floor_irradiance_under_a_rectangle_light_matches_lamberts_formula() {
     // The Cornell box's floor and light (experiments/scenes/cbox.xml), nothing else.
-    assert_floor_under_the_cbox_light(
-        r#"<shape type="rectangle">
-            <transform name="to_world">
-                <scale x="0.23" y="0.19"/><rotate x="1" angle="90"/><translate y="0.99"/>
-            </transform>"#,
-        Path::new("test-scene.xml"),
-        None,
-    );
+    assert_floor_under_the_cbox_light(CBOX_LIGHT_RECTANGLE, Path::new("test-scene.xml"), None);
 }
 
 /// A crop window renders its part of the film: the cropped image's pixels against
@@ -334,10 +334,7 @@ fn floor_irradiance_under_a_rectangle_light_matches_lamberts_formula() {
 #[test]
 fn a_crop_window_shows_the_floor_where_the_full_film_does() {
     assert_floor_under_the_cbox_light(
-        r#"<shape type="rectangle">
-            <transform name="to_world">
-                <scale x="0.23" y="0.19"/><rotate x="1" angle="90"/><translate y="0.99"/>
-            </transform>"#,
+        CBOX_LIGHT_RECTANGLE,
         Path::new("test-scene.xml"),
         Some(CropWindow {
             x: 3,

@@ -499,12 +499,22 @@ fn cli_prints_each_warning_once() {
     assert!(stderr.contains("scene.xml:2"), "{stderr}");
 }
 
-/// Starts `mltbench ARGS` in `dir`, waits until it announces that Ctrl-C is handled, sends
-/// SIGINT, and returns (exit status, the rest of its standard error).
-fn interrupt_after_announcement(dir: &Path, args: &[&str]) -> (Option<i32>, String) {
+/// Starts `mltbench COMMAND cbox.xml --estimator pt -D res=32 --spp 100000000 --threads 1
+/// -o OUTPUT` in `dir`, waits until it announces that Ctrl-C is handled, sends SIGINT, and
+/// returns (exit status, the rest of its standard error).
+fn interrupt_after_announcement(dir: &Path, command: &str, output: &str) -> (Option<i32>, String) {
     use std::io::{BufRead, BufReader, Read};
+    let scene = scenes_dir().join("cbox.xml");
     let mut child = Command::new(env!("CARGO_BIN_EXE_mltbench"))
-        .args(args)
+        .args([
+            command,
+            scene.to_str().unwrap(),
+            "--estimator",
+            "pt",
+            "-D",
+            "res=32",
+        ])
+        .args(["--spp", "100000000", "--threads", "1", "-o", output])
         .current_dir(dir)
         .stderr(std::process::Stdio::piped())
         .spawn()
@@ -530,24 +540,7 @@ fn interrupt_after_announcement(dir: &Path, args: &[&str]) -> (Option<i32>, Stri
 #[test]
 fn cli_writes_the_passes_done_when_interrupted() {
     let dir = temp_dir("interrupted");
-    let scene = scenes_dir().join("cbox.xml");
-    let (status, rest) = interrupt_after_announcement(
-        &dir,
-        &[
-            "render",
-            scene.to_str().unwrap(),
-            "--estimator",
-            "pt",
-            "-D",
-            "res=32",
-            "--spp",
-            "100000000",
-            "--threads",
-            "1",
-            "-o",
-            "cut.exr",
-        ],
-    );
+    let (status, rest) = interrupt_after_announcement(&dir, "render", "cut.exr");
     assert_eq!(status, Some(130), "{rest}");
     assert!(rest.contains("interrupted: the image holds the"), "{rest}");
     let image = mltbench::io::exr::read_exr(&dir.join("cut.exr")).unwrap();
@@ -561,24 +554,7 @@ fn cli_writes_the_passes_done_when_interrupted() {
 #[test]
 fn cli_reference_keeps_two_equal_halves_when_interrupted() {
     let dir = temp_dir("interrupted_reference");
-    let scene = scenes_dir().join("cbox.xml");
-    let (status, rest) = interrupt_after_announcement(
-        &dir,
-        &[
-            "reference",
-            scene.to_str().unwrap(),
-            "--estimator",
-            "pt",
-            "-D",
-            "res=32",
-            "--spp",
-            "100000000",
-            "--threads",
-            "1",
-            "-o",
-            "ref.exr",
-        ],
-    );
+    let (status, rest) = interrupt_after_announcement(&dir, "reference", "ref.exr");
     assert_eq!(status, Some(130), "{rest}");
     assert!(rest.contains("stopped on request"), "{rest}");
     let reference = mltbench::experiment::reference::load(&dir.join("ref.exr")).unwrap();
