@@ -715,6 +715,9 @@ fn hide_emitters_is_read_from_path_and_direct() {
             )),
         );
         assert!(desc.integrator.hide_emitters, "{kind}");
+        // Only `direct` differs from the path integrator's rule, and says so.
+        let warned = desc.warnings.iter().any(|w| w.contains("hide_emitters"));
+        assert_eq!(warned, kind == "direct", "{kind}: {:?}", desc.warnings);
     }
     // Through a wrapper too; false is the default.
     let desc = load_ok(

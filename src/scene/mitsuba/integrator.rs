@@ -44,9 +44,21 @@ impl Builder<'_> {
                     "shading_samples",
                     "timeout",
                 ]);
+                let hide = hide_emitters(&props)?;
+                if hide {
+                    // Measured against Mitsuba 3.9.1 (llvm_ad_rgb): its `direct` shows the
+                    // environment through a null surface, its `path` does not.
+                    let w = tree.warning(
+                        props.elem_of("hide_emitters"),
+                        "hide_emitters follows Mitsuba's path integrator: the environment \
+                         seen only through null surfaces is hidden too (Mitsuba's direct \
+                         integrator shows it)",
+                    );
+                    self.desc.warnings.push(w);
+                }
                 IntegratorDesc {
                     max_depth: 2,
-                    hide_emitters: hide_emitters(&props)?,
+                    hide_emitters: hide,
                     ..IntegratorDesc::default()
                 }
             }
