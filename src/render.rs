@@ -15,6 +15,17 @@ pub enum Budget {
     Seconds(f64),
 }
 
+impl Budget {
+    /// True once `passes` passes begun at `start` use the budget up (a time budget always
+    /// allows the first pass).
+    pub fn is_spent(self, passes: u32, start: Instant) -> bool {
+        match self {
+            Budget::Passes(n) => passes >= n,
+            Budget::Seconds(s) => passes > 0 && start.elapsed().as_secs_f64() >= s,
+        }
+    }
+}
+
 /// What a finished render hands back.
 pub struct RenderOutput {
     pub image: Image,
@@ -38,11 +49,7 @@ pub fn render(
     let mut pass = 0u32;
     let mut interrupted = false;
     loop {
-        let done = match budget {
-            Budget::Passes(n) => pass >= n,
-            Budget::Seconds(s) => pass > 0 && start.elapsed().as_secs_f64() >= s,
-        };
-        if done {
+        if budget.is_spent(pass, start) {
             break;
         }
         if pass > 0 && crate::interrupt::requested() {

@@ -78,14 +78,15 @@ pub fn render_reference(
             half_seed,
         )?);
     }
+    // Passes are counted per half; time is shared by both.
+    let per_half = match budget {
+        Budget::Passes(p) => Budget::Passes(p.div_ceil(2)),
+        seconds => seconds,
+    };
     let start = Instant::now();
     let mut pass = 0u32;
     loop {
-        let done = match budget {
-            Budget::Passes(p) => pass >= p.div_ceil(2),
-            Budget::Seconds(s) => pass > 0 && start.elapsed().as_secs_f64() >= s,
-        };
-        if done || (pass > 0 && crate::interrupt::requested()) {
+        if per_half.is_spent(pass, start) || (pass > 0 && crate::interrupt::requested()) {
             break;
         }
         for (half, est) in estimators.iter_mut().enumerate() {
