@@ -20,5 +20,6 @@ pub mod path;
 pub mod render;
 pub mod sampler;
 pub mod scene;
+pub mod texture;
 
 pub use error::{Error, Result};

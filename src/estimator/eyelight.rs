@@ -72,7 +72,7 @@ impl CameraSampleFn for Shade {
             {
                 return (*radiance, crossing as u64 + 1);
             }
-            let albedo = bsdf.diffuse_albedo().unwrap_or(Rgb::splat(0.5));
+            let albedo = bsdf.diffuse_albedo_at(hit.uv).unwrap_or(Rgb::splat(0.5));
             return (albedo * hit.ns.dot(toward_eye).abs(), crossing as u64 + 1);
         }
         (Rgb::BLACK, MAX_NULL_CROSSINGS as u64 + 1)

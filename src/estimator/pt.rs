@@ -224,7 +224,7 @@ impl CameraSampleFn for PathSample {
                 break;
             }
 
-            let bsdf = scene.bsdf_of_shape(si.shape);
+            let bsdf = &*scene.bsdf_at(&si);
             let frame = si.frame();
             let wo = frame.to_local(wo_world);
 

@@ -200,6 +200,10 @@ impl Bsdf {
     pub fn from_desc(desc: &BsdfDesc) -> Bsdf {
         match desc {
             BsdfDesc::Diffuse { reflectance } => Bsdf::Diffuse(Diffuse::new(*reflectance)),
+            // Away from any surface point: the texture's mean (`from_desc_at` looks it up).
+            BsdfDesc::TexturedDiffuse { reflectance } => {
+                Bsdf::Diffuse(Diffuse::new(reflectance.mean()))
+            }
             BsdfDesc::Conductor {
                 eta_k,
                 specular_reflectance,
@@ -300,6 +304,20 @@ impl Bsdf {
                 *diffuse_reflectance,
                 *specular_reflectance,
             )),
+        }
+    }
+
+    /// The BSDF at surface coordinates `uv`: `from_desc` with every texture looked up there.
+    pub fn from_desc_at(desc: &BsdfDesc, uv: Vec2) -> Bsdf {
+        match desc {
+            BsdfDesc::TexturedDiffuse { reflectance } => {
+                Bsdf::Diffuse(Diffuse::new(reflectance.eval(uv)))
+            }
+            BsdfDesc::TwoSided { front, back } => Bsdf::TwoSided(Box::new(TwoSided::new(
+                Bsdf::from_desc_at(front, uv),
+                Bsdf::from_desc_at(back, uv),
+            ))),
+            _ => Bsdf::from_desc(desc),
         }
     }
 

@@ -7,6 +7,7 @@ use glam::{Vec2, Vec3};
 
 use crate::error::Location;
 use crate::math::{Rgb, Transform};
+use crate::texture::Texture;
 
 /// Everything a scene file describes, in world space.
 #[derive(Clone, Debug, Default)]
@@ -176,7 +177,8 @@ impl Default for FilterDesc {
     }
 }
 
-/// A reflectance or other colour parameter. Only constants for now; bitmap textures later.
+/// A reflectance or other colour parameter: a constant. A texture is read only for diffuse
+/// reflectance, as `BsdfDesc::TexturedDiffuse`.
 pub type ColorParam = Rgb;
 
 /// Index of refraction pair of a dielectric interface.
@@ -208,6 +210,10 @@ pub struct Roughness {
 pub enum BsdfDesc {
     Diffuse {
         reflectance: ColorParam,
+    },
+    /// `diffuse` whose reflectance is a texture, looked up at each hit (`Scene::bsdf_at`).
+    TexturedDiffuse {
+        reflectance: Texture,
     },
     /// Smooth conductor. `eta`/`k` complex IOR per channel; `material="none"` gives
     /// `eta = k = None`: a perfect mirror (reflectance 1, no Fresnel term).
@@ -280,8 +286,27 @@ impl BsdfDesc {
     pub fn diffuse_albedo(&self) -> Option<Rgb> {
         match self {
             BsdfDesc::Diffuse { reflectance } => Some(*reflectance),
+            BsdfDesc::TexturedDiffuse { reflectance } => Some(reflectance.mean()),
             BsdfDesc::TwoSided { front, .. } => front.diffuse_albedo(),
             _ => None,
+        }
+    }
+
+    /// The diffuse albedo at surface coordinates `uv` (textures looked up there).
+    pub fn diffuse_albedo_at(&self, uv: Vec2) -> Option<Rgb> {
+        match self {
+            BsdfDesc::TexturedDiffuse { reflectance } => Some(reflectance.eval(uv)),
+            BsdfDesc::TwoSided { front, .. } => front.diffuse_albedo_at(uv),
+            _ => self.diffuse_albedo(),
+        }
+    }
+
+    /// True when some parameter is a texture: the BSDF differs from point to point.
+    pub fn is_textured(&self) -> bool {
+        match self {
+            BsdfDesc::TexturedDiffuse { .. } => true,
+            BsdfDesc::TwoSided { front, back } => front.is_textured() || back.is_textured(),
+            _ => false,
         }
     }
 }

@@ -7,13 +7,14 @@ pub mod obj;
 pub mod ply;
 pub mod spectra;
 
+use std::borrow::Cow;
 use std::path::Path;
 
 pub use description::*;
 
 use crate::camera::Camera;
 use crate::error::Result;
-use crate::geometry::Geometry;
+use crate::geometry::{Geometry, SurfaceInteraction};
 use crate::light::LightSet;
 use crate::material::Bsdf;
 
@@ -25,7 +26,10 @@ pub struct Scene {
     /// Every emitter, in the order of `description.emitters`, and the choice among them.
     pub lights: LightSet,
     /// The BSDFs, in the order of `description.bsdfs` (`ShapeDesc::bsdf` indexes both).
+    /// A textured one holds its textures' means; `bsdf_at` looks them up at a hit.
     pub bsdfs: Vec<Bsdf>,
+    /// Per BSDF: true when it has a texture.
+    textured: Vec<bool>,
 }
 
 impl Scene {
@@ -37,6 +41,11 @@ impl Scene {
     pub fn build(description: SceneDescription) -> Result<Scene> {
         let lights = LightSet::build(&description)?;
         let bsdfs = description.bsdfs.iter().map(Bsdf::from_desc).collect();
+        let textured = description
+            .bsdfs
+            .iter()
+            .map(BsdfDesc::is_textured)
+            .collect();
         let geometry = Geometry::build(&description.shapes);
         let camera = Camera::new(&description.sensor);
         Ok(Scene {
@@ -45,12 +54,26 @@ impl Scene {
             camera,
             lights,
             bsdfs,
+            textured,
         })
     }
 
-    /// The BSDF of shape `shape`.
+    /// The BSDF of shape `shape`, textures at their means (see `bsdf_at`).
     pub fn bsdf_of_shape(&self, shape: u32) -> &Bsdf {
         &self.bsdfs[self.description.shapes[shape as usize].bsdf]
+    }
+
+    /// The BSDF at a surface point: the shape's, with its textures looked up at `si.uv`.
+    /// Untextured BSDFs are borrowed; a textured one is built for the point (a `twosided`
+    /// one allocates its two sides).
+    #[inline]
+    pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Cow<'_, Bsdf> {
+        let index = self.description.shapes[si.shape as usize].bsdf;
+        if self.textured[index] {
+            Cow::Owned(Bsdf::from_desc_at(&self.description.bsdfs[index], si.uv))
+        } else {
+            Cow::Borrowed(&self.bsdfs[index])
+        }
     }
 
     /// Width of the rendered image: the film's crop window, if it has one.

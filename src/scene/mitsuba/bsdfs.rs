@@ -23,6 +23,7 @@ use crate::error::Result;
 use crate::math::Rgb;
 use crate::scene::spectra::{SpectrumUse, named_conductor, named_ior, spectrum_to_rgb};
 use crate::scene::{BsdfDesc, IorPair, MicrofacetKind, Roughness};
+use crate::texture::Texture;
 
 /// Named IORs used as defaults (the values of Mitsuba's IOR table).
 const IOR_BK7: f32 = 1.5046;
@@ -98,8 +99,11 @@ impl Builder<'_> {
         let kind = tree.type_of(elem);
         let props = Props::collect(tree, elem)?;
         let desc = match kind {
-            "diffuse" => BsdfDesc::Diffuse {
-                reflectance: self.reflectance(&props, "reflectance", 0.5)?,
+            "diffuse" => match self.texture_param(&props, "reflectance")? {
+                Some(reflectance) => BsdfDesc::TexturedDiffuse { reflectance },
+                None => BsdfDesc::Diffuse {
+                    reflectance: self.reflectance(&props, "reflectance", 0.5)?,
+                },
             },
             "conductor" => {
                 let eta_k = conductor_ior(&props)?;
@@ -213,6 +217,31 @@ impl Builder<'_> {
         Ok(desc)
     }
 
+    /// The texture given as parameter `name` (nested or referenced), if any; an error when
+    /// the parameter is also given as a value.
+    fn texture_param(&mut self, props: &Props, name: &str) -> Result<Option<Texture>> {
+        let tree = self.tree;
+        let Some(i) = props
+            .objects()
+            .iter()
+            .position(|o| tree.tag(o.target) == "texture" && o.name.as_deref() == Some(name))
+        else {
+            return Ok(None);
+        };
+        props.use_object(i);
+        let object = &props.objects()[i];
+        if props.has(name) {
+            return Err(tree.error(
+                object.via,
+                format!(
+                    "\"{name}\" given twice: as a texture and at line {}",
+                    tree.elem(props.elem_of(name)).line
+                ),
+            ));
+        }
+        self.texture(object.target).map(Some)
+    }
+
     /// `twosided`: one nested BSDF for both sides, or front and back.
     fn twosided(&mut self, props: &Props) -> Result<BsdfDesc> {
         let tree = self.tree;
@@ -264,7 +293,7 @@ impl Builder<'_> {
     /// (Mitsuba 3 refuses only an `<rgb>` outside; it renders a `<float>` of 5 as it is and
     /// clamps a spectrum's RGB). A spectrum's samples must lie in [0, 1]; its RGB, when out of
     /// gamut, is clamped as Mitsuba does, with a warning.
-    fn reflectance(&mut self, props: &Props, name: &str, default: f32) -> Result<Rgb> {
+    pub(super) fn reflectance(&mut self, props: &Props, name: &str, default: f32) -> Result<Rgb> {
         let Some(rgb) = props.color(name)? else {
             return Ok(Rgb::splat(default));
         };

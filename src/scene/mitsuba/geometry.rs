@@ -27,32 +27,49 @@ pub(super) fn rectangle() -> TriangleMesh {
     }
 }
 
-/// `cube`: [-1, 1]³, four vertices per face (flat faces), counter-clockwise seen from
-/// outside so every geometric normal points outward.
+/// `cube`: [-1, 1]³ as Mitsuba 3 builds it, four vertices per face (flat faces), every
+/// face's uvs running from (0, 0) to (1, 1) in Mitsuba's orientation, counter-clockwise
+/// seen from outside so every geometric normal points outward. The tables are Mitsuba's
+/// mesh as `mitsuba.traverse` lists it (positions, texcoords, faces).
 pub(super) fn cube() -> TriangleMesh {
+    // Per face (−y, +y, +x, +z, −x, −z): its four corners in Mitsuba's order.
+    const CORNERS: [[[f32; 3]; 4]; 6] = [
+        [
+            [1., -1., -1.],
+            [1., -1., 1.],
+            [-1., -1., 1.],
+            [-1., -1., -1.],
+        ],
+        [[1., 1., -1.], [-1., 1., -1.], [-1., 1., 1.], [1., 1., 1.]],
+        [[1., -1., -1.], [1., 1., -1.], [1., 1., 1.], [1., -1., 1.]],
+        [[1., -1., 1.], [1., 1., 1.], [-1., 1., 1.], [-1., -1., 1.]],
+        [
+            [-1., -1., 1.],
+            [-1., 1., 1.],
+            [-1., 1., -1.],
+            [-1., -1., -1.],
+        ],
+        [
+            [1., 1., -1.],
+            [1., -1., -1.],
+            [-1., -1., -1.],
+            [-1., 1., -1.],
+        ],
+    ];
+    // The same uvs at the four corners of every face.
+    const UVS: [[f32; 2]; 4] = [[0., 1.], [1., 1.], [1., 0.], [0., 0.]];
     let mut mesh = TriangleMesh {
         uvs: Some(Vec::new()),
         ..TriangleMesh::default()
     };
-    for axis in 0..3 {
-        for sign in [1.0f32, -1.0] {
-            let n = Vec3::AXES[axis] * sign;
-            // (u, v, n) right-handed: u × v = n.
-            let (u, v) = if sign > 0.0 {
-                (Vec3::AXES[(axis + 1) % 3], Vec3::AXES[(axis + 2) % 3])
-            } else {
-                (Vec3::AXES[(axis + 2) % 3], Vec3::AXES[(axis + 1) % 3])
-            };
-            let base = mesh.positions.len() as u32;
-            for (du, dv) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                mesh.positions.push(n + u * du + v * dv);
-                if let Some(uvs) = &mut mesh.uvs {
-                    uvs.push(Vec2::new((du + 1.0) / 2.0, (dv + 1.0) / 2.0));
-                }
-            }
-            mesh.indices.push([base, base + 1, base + 2]);
-            mesh.indices.push([base, base + 2, base + 3]);
+    for face in CORNERS {
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend(face.map(Vec3::from));
+        if let Some(uvs) = &mut mesh.uvs {
+            uvs.extend(UVS.map(Vec2::from));
         }
+        mesh.indices.push([base, base + 1, base + 2]);
+        mesh.indices.push([base + 3, base, base + 2]);
     }
     mesh
 }

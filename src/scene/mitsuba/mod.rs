@@ -8,7 +8,8 @@
 //! Mitsuba. Any error aborts the load: there is never a half-built scene.
 //!
 //! Deliberate differences from Mitsuba 3, each a clear error rather than a silent change:
-//! a scene with no shapes is rejected; media, textures and unsupported plugins are
+//! a scene with no shapes is rejected; media, textures other than a diffuse reflectance, and
+//! unsupported plugins are
 //! "not supported yet"; an undefined `$name` is an error even when no `<default>` exists.
 
 mod bsdfs;
@@ -17,6 +18,7 @@ mod geometry;
 mod integrator;
 mod sensor;
 mod shapes;
+mod textures;
 mod transform;
 mod values;
 mod xml;
@@ -28,6 +30,7 @@ use glam::Vec3;
 
 use super::{BsdfDesc, SceneDescription, ShapeGeometry};
 use crate::error::{Error, Location, Result};
+use crate::texture::Texture;
 use xml::{ElemId, Tree};
 
 /// Reads a scene file and everything it includes or references.
@@ -65,6 +68,8 @@ pub(super) struct Builder<'a> {
     desc: SceneDescription,
     /// BSDFs parsed so far, by element (a referenced BSDF is parsed once).
     parsed_bsdfs: HashMap<ElemId, BsdfDesc>,
+    /// Textures parsed so far, by element (a referenced texture is read once).
+    parsed_textures: HashMap<ElemId, Texture>,
     /// Index in `desc.bsdfs` of each BSDF element used by a shape or written at top level.
     bsdf_indices: HashMap<ElemId, usize>,
     /// Index of the default BSDF of shapes without one: [not emitting, emitting].
@@ -91,6 +96,7 @@ impl<'a> Builder<'a> {
             tree,
             desc,
             parsed_bsdfs: HashMap::new(),
+            parsed_textures: HashMap::new(),
             bsdf_indices: HashMap::new(),
             default_bsdf: [None, None],
             attached_emitters: HashMap::new(),
@@ -162,8 +168,9 @@ impl<'a> Builder<'a> {
                     self.bsdf_index(elem)?;
                 }
                 "emitter" if !self.standalone_emitter(elem)? => loose_area_emitters.push(elem),
+                // Read where a BSDF uses it; read here too, so that a broken one is an error.
                 "texture" => {
-                    return Err(tree.error(elem, "textures are not supported yet"));
+                    self.texture(elem)?;
                 }
                 "medium" | "phase" | "volume" => {
                     return Err(tree.error(elem, "participating media are not supported yet"));

@@ -270,7 +270,7 @@ impl Builder<'_> {
         Ok(Ok(ShapeGeometry::Mesh(mesh)))
     }
 
-    fn note_file(&mut self, path: PathBuf) {
+    pub(super) fn note_file(&mut self, path: PathBuf) {
         if !self.desc.files_read.contains(&path) {
             self.desc.files_read.push(path);
         }

@@ -191,13 +191,22 @@ impl<'a> Props<'a> {
                 }
             }
         }
+        // mltbench reads a texture only as a diffuse BSDF's reflectance (`textures.rs`).
+        let takes_texture = |name: &Option<String>| {
+            tree.tag(owner) == "bsdf"
+                && tree.type_of(owner) == "diffuse"
+                && name.as_deref() == Some("reflectance")
+        };
         for object in &objects {
-            if tree.tag(object.target) == "texture" {
+            if tree.tag(object.target) == "texture" && !takes_texture(&object.name) {
                 return Err(tree.error(
                     object.via,
                     format!(
-                        "{} textures are not supported yet (use a constant <rgb> or <spectrum>)",
-                        tree.describe(object.target)
+                        "{} as \"{}\" of {}: mltbench reads textures only as a diffuse \
+                         BSDF's reflectance (use a constant <rgb> or <spectrum>)",
+                        tree.describe(object.target),
+                        object.name.as_deref().unwrap_or(""),
+                        tree.describe(owner)
                     ),
                 ));
             }
