@@ -3,7 +3,7 @@
 //!
 //! The uv conventions asserted here (the image's first row at v = 0, the rectangle's uvs
 //! running from (0, 0) at its (−1, −1) corner) are Mitsuba 3's, found by rendering a probe
-//! scene with both renderers (README "Textures").
+//! scene with both renderers (`experiments/scenes/textures.xml`; README, "Scene subset").
 
 mod loader_support;
 
