@@ -53,15 +53,16 @@ fn test_codes() -> Vec<Vec<[u8; 3]>> {
         .collect()
 }
 
+/// The texture of shape `shape`'s BSDF (inside a `twosided` too).
 fn diffuse_texture(desc: &mltbench::scene::SceneDescription, shape: usize) -> Texture {
-    match &desc.bsdfs[desc.shapes[shape].bsdf] {
-        BsdfDesc::TexturedDiffuse { reflectance } => reflectance.clone(),
-        BsdfDesc::TwoSided { front, .. } => match front.as_ref() {
-            BsdfDesc::TexturedDiffuse { reflectance } => reflectance.clone(),
-            other => panic!("expected a textured diffuse, got {other:?}"),
-        },
-        other => panic!("expected a textured diffuse, got {other:?}"),
+    fn of(bsdf: &BsdfDesc) -> Texture {
+        match bsdf {
+            BsdfDesc::Textured { diffuse, .. } => diffuse.clone(),
+            BsdfDesc::TwoSided { front, .. } => of(front),
+            other => panic!("expected a textured BSDF, got {other:?}"),
+        }
     }
+    of(&desc.bsdfs[desc.shapes[shape].bsdf])
 }
 
 #[test]
@@ -275,7 +276,7 @@ fn mean_over(image: &Image, pixels: &[(u32, u32)], c: usize) -> (f64, f64) {
 const HALF: f32 = 1.5;
 const SKY: f64 = 2.0;
 
-fn textured_plane(dir: &Path, texture: &str) -> Scene {
+fn textured_plane(dir: &Path, bsdf: &str) -> Scene {
     let text = format!(
         r#"<scene version="3.0.0">
             <sensor type="perspective">
@@ -287,7 +288,7 @@ fn textured_plane(dir: &Path, texture: &str) -> Scene {
             <emitter type="constant"><rgb name="radiance" value="{SKY}"/></emitter>
             <shape type="rectangle">
                 <transform name="to_world"><scale value="{HALF}"/><translate z="-3"/></transform>
-                <bsdf type="diffuse">{texture}</bsdf>
+                {bsdf}
             </shape>
         </scene>"#
     );
@@ -364,7 +365,7 @@ fn a_textured_plane_under_a_uniform_sky_shows_texture_times_sky() {
         (bitmap, &texel as &dyn Fn(f64, f64) -> Option<[u64; 3]>, 12),
         (checkerboard, &check, 2),
     ] {
-        let scene = textured_plane(&dir, texture);
+        let scene = textured_plane(&dir, &format!("<bsdf type=\"diffuse\">{texture}</bsdf>"));
         let groups = pixels_by_reflectance(&scene, reflectance);
         assert_eq!(groups.len(), groups_expected, "every texel or cell is seen");
         let params = Params::parse::<&str>(&[]).unwrap();
@@ -382,6 +383,67 @@ fn a_textured_plane_under_a_uniform_sky_shows_texture_times_sky() {
                     z.abs() <= SIGMAS,
                     "channel {c}: {mean} ± {se} against ρL = {expected} ({z:.2} σ, {} pixels)",
                     pixels.len()
+                );
+            }
+        }
+    }
+}
+
+/// Render of `scene` by `pt`: 64 passes.
+fn render_pt(scene: &Scene, seed: u64) -> Image {
+    let params = Params::parse::<&str>(&[]).unwrap();
+    let mut pt = estimator::create("pt", &params, scene, seed).unwrap();
+    render(scene, pt.as_mut(), Budget::Passes(64), |_, _| {}).image
+}
+
+/// A plastic whose diffuse reflectance is a texture renders, in each checker cell, what the
+/// plastic with that cell's colour as a constant renders there (independent runs, 4 σ).
+#[test]
+fn a_textured_plastic_matches_the_constant_plastic_of_each_cell() {
+    let dir = scratch("textured_plastic");
+    let colors = ["0.8, 0.3, 0.1", "0.1, 0.5, 0.9"];
+    let check = |u: f64, v: f64| {
+        let same = ((u * 4.0) as u64 + (v * 4.0) as u64).is_multiple_of(2);
+        Some([same as u64; 3])
+    };
+    for kind in ["plastic", "roughplastic"] {
+        let plastic = |reflectance: &str| {
+            format!(
+                "<bsdf type=\"{kind}\"><float name=\"int_ior\" value=\"1.6\"/>{reflectance}</bsdf>"
+            )
+        };
+        let textured = textured_plane(
+            &dir,
+            &plastic(&format!(
+                "<texture type=\"checkerboard\" name=\"diffuse_reflectance\">\
+                 <rgb name=\"color0\" value=\"{}\"/><rgb name=\"color1\" value=\"{}\"/>\
+                 <transform name=\"to_uv\"><scale value=\"2\"/></transform></texture>",
+                colors[0], colors[1]
+            )),
+        );
+        assert!(matches!(
+            &textured.description.bsdfs[0],
+            BsdfDesc::Textured { .. }
+        ));
+        let image = render_pt(&textured, 11);
+        let groups = pixels_by_reflectance(&textured, check);
+        assert_eq!(groups.len(), 2);
+        for (key, pixels) in groups {
+            let color = colors[if key[0] == 1 { 0 } else { 1 }];
+            let constant = textured_plane(
+                &dir,
+                &plastic(&format!(
+                    "<rgb name=\"diffuse_reflectance\" value=\"{color}\"/>"
+                )),
+            );
+            let reference = render_pt(&constant, 12);
+            for c in 0..3 {
+                let (a, sa) = mean_over(&image, &pixels, c);
+                let (b, sb) = mean_over(&reference, &pixels, c);
+                let z = (a - b) / sa.hypot(sb).max(1e-9);
+                assert!(
+                    z.abs() <= SIGMAS,
+                    "{kind}, colour {color}, channel {c}: {a} ± {sa} against {b} ± {sb} ({z:.2} σ)"
                 );
             }
         }

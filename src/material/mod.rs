@@ -200,10 +200,8 @@ impl Bsdf {
     pub fn from_desc(desc: &BsdfDesc) -> Bsdf {
         match desc {
             BsdfDesc::Diffuse { reflectance } => Bsdf::Diffuse(Diffuse::new(*reflectance)),
-            // Away from any surface point: the texture's mean (`from_desc_at` looks it up).
-            BsdfDesc::TexturedDiffuse { reflectance } => {
-                Bsdf::Diffuse(Diffuse::new(reflectance.mean()))
-            }
+            // Away from any surface point: the texture's mean (`at_point` looks it up).
+            BsdfDesc::Textured { base, .. } => Bsdf::from_desc(base),
             BsdfDesc::Conductor {
                 eta_k,
                 specular_reflectance,
@@ -307,17 +305,28 @@ impl Bsdf {
         }
     }
 
-    /// The BSDF at surface coordinates `uv`: `from_desc` with every texture looked up there.
-    pub fn from_desc_at(desc: &BsdfDesc, uv: Vec2) -> Bsdf {
-        match desc {
-            BsdfDesc::TexturedDiffuse { reflectance } => {
-                Bsdf::Diffuse(Diffuse::new(reflectance.eval(uv)))
+    /// This BSDF (built from `desc`) at surface coordinates `uv`: every texture of `desc`
+    /// looked up there.
+    pub fn at_point(&self, desc: &BsdfDesc, uv: Vec2) -> Bsdf {
+        match (desc, self) {
+            (BsdfDesc::Textured { diffuse, .. }, _) => {
+                self.with_diffuse_reflectance(diffuse.eval(uv))
             }
-            BsdfDesc::TwoSided { front, back } => Bsdf::TwoSided(Box::new(TwoSided::new(
-                Bsdf::from_desc_at(front, uv),
-                Bsdf::from_desc_at(back, uv),
-            ))),
-            _ => Bsdf::from_desc(desc),
+            (BsdfDesc::TwoSided { front, back }, Bsdf::TwoSided(t)) => Bsdf::TwoSided(Box::new(
+                TwoSided::new(t.front.at_point(front, uv), t.back.at_point(back, uv)),
+            )),
+            _ => self.clone(),
+        }
+    }
+
+    /// The same BSDF with diffuse reflectance `rho` (`diffuse`, `plastic`, `roughplastic`;
+    /// other models, which have none, are returned unchanged).
+    pub fn with_diffuse_reflectance(&self, rho: Rgb) -> Bsdf {
+        match self {
+            Bsdf::Diffuse(_) => Bsdf::Diffuse(Diffuse::new(rho)),
+            Bsdf::Plastic(p) => Bsdf::Plastic(p.with_diffuse_reflectance(rho)),
+            Bsdf::RoughPlastic(p) => Bsdf::RoughPlastic(Box::new(p.with_diffuse_reflectance(rho))),
+            other => other.clone(),
         }
     }
 

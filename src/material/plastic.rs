@@ -52,6 +52,17 @@ impl Plastic {
         }
     }
 
+    /// The same plastic with diffuse reflectance `diffuse` (a texture's value at a point).
+    /// The lobe-selection weight stays: Mitsuba 3 sets it once, from the texture's mean.
+    pub fn with_diffuse_reflectance(&self, diffuse: Rgb) -> Self {
+        let fdr_int = diffuse_fresnel_reflectance(1.0 / self.eta);
+        Plastic {
+            diffuse_reflectance: diffuse,
+            diffuse_scaled: internal_scattering(diffuse, fdr_int, self.nonlinear),
+            ..self.clone()
+        }
+    }
+
     /// (probability of the specular lobe, of the diffuse lobe) for a given F(θo).
     fn lobe_probabilities(&self, f_o: f32) -> (f32, f32) {
         let ps = f_o * self.specular_weight;

@@ -90,6 +90,17 @@ impl RoughPlastic {
         }
     }
 
+    /// The same plastic with diffuse reflectance `diffuse` (a texture's value at a point).
+    /// The tables depend on η and α only; the lobe-selection weight stays, as Mitsuba 3
+    /// sets it once from the texture's mean.
+    pub fn with_diffuse_reflectance(&self, diffuse: Rgb) -> Self {
+        RoughPlastic {
+            diffuse_reflectance: diffuse,
+            diffuse_scaled: internal_scattering(diffuse, self.internal_reflectance, self.nonlinear),
+            ..self.clone()
+        }
+    }
+
     /// The tabulated transmission albedo t(μ) (linear interpolation).
     pub fn external_transmittance(&self, cos_theta: f32) -> f32 {
         let x = cos_theta.clamp(0.0, 1.0) * (TABLE_SIZE - 1) as f32;

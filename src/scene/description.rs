@@ -177,8 +177,8 @@ impl Default for FilterDesc {
     }
 }
 
-/// A reflectance or other colour parameter: a constant. A texture is read only for diffuse
-/// reflectance, as `BsdfDesc::TexturedDiffuse`.
+/// A reflectance or other colour parameter: a constant. A texture is read only for a diffuse
+/// reflectance, as `BsdfDesc::Textured`.
 pub type ColorParam = Rgb;
 
 /// Index of refraction pair of a dielectric interface.
@@ -211,9 +211,12 @@ pub enum BsdfDesc {
     Diffuse {
         reflectance: ColorParam,
     },
-    /// `diffuse` whose reflectance is a texture, looked up at each hit (`Scene::bsdf_at`).
-    TexturedDiffuse {
-        reflectance: Texture,
+    /// `base` (a `diffuse`, `plastic` or `roughplastic`) whose diffuse reflectance is a
+    /// texture, looked up at each hit (`Scene::bsdf_at`). `base` holds the texture's mean,
+    /// which is also what sets a plastic's lobe-selection weight (Mitsuba 3 does the same).
+    Textured {
+        base: Box<BsdfDesc>,
+        diffuse: Texture,
     },
     /// Smooth conductor. `eta`/`k` complex IOR per channel; `material="none"` gives
     /// `eta = k = None`: a perfect mirror (reflectance 1, no Fresnel term).
@@ -286,7 +289,7 @@ impl BsdfDesc {
     pub fn diffuse_albedo(&self) -> Option<Rgb> {
         match self {
             BsdfDesc::Diffuse { reflectance } => Some(*reflectance),
-            BsdfDesc::TexturedDiffuse { reflectance } => Some(reflectance.mean()),
+            BsdfDesc::Textured { base, .. } => base.diffuse_albedo(),
             BsdfDesc::TwoSided { front, .. } => front.diffuse_albedo(),
             _ => None,
         }
@@ -295,7 +298,10 @@ impl BsdfDesc {
     /// The diffuse albedo at surface coordinates `uv` (textures looked up there).
     pub fn diffuse_albedo_at(&self, uv: Vec2) -> Option<Rgb> {
         match self {
-            BsdfDesc::TexturedDiffuse { reflectance } => Some(reflectance.eval(uv)),
+            BsdfDesc::Textured { base, diffuse } => match base.as_ref() {
+                BsdfDesc::Diffuse { .. } => Some(diffuse.eval(uv)),
+                _ => None,
+            },
             BsdfDesc::TwoSided { front, .. } => front.diffuse_albedo_at(uv),
             _ => self.diffuse_albedo(),
         }
@@ -304,7 +310,7 @@ impl BsdfDesc {
     /// True when some parameter is a texture: the BSDF differs from point to point.
     pub fn is_textured(&self) -> bool {
         match self {
-            BsdfDesc::TexturedDiffuse { .. } => true,
+            BsdfDesc::Textured { .. } => true,
             BsdfDesc::TwoSided { front, back } => front.is_textured() || back.is_textured(),
             _ => false,
         }

@@ -65,12 +65,12 @@ impl Scene {
 
     /// The BSDF at a surface point: the shape's, with its textures looked up at `si.uv`.
     /// Untextured BSDFs are borrowed; a textured one is built for the point (a `twosided`
-    /// one allocates its two sides).
+    /// or `roughplastic` one allocates).
     #[inline]
     pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Cow<'_, Bsdf> {
         let index = self.description.shapes[si.shape as usize].bsdf;
         if self.textured[index] {
-            Cow::Owned(Bsdf::from_desc_at(&self.description.bsdfs[index], si.uv))
+            Cow::Owned(self.bsdfs[index].at_point(&self.description.bsdfs[index], si.uv))
         } else {
             Cow::Borrowed(&self.bsdfs[index])
         }

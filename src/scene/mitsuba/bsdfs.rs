@@ -100,7 +100,12 @@ impl Builder<'_> {
         let props = Props::collect(tree, elem)?;
         let desc = match kind {
             "diffuse" => match self.texture_param(&props, "reflectance")? {
-                Some(reflectance) => BsdfDesc::TexturedDiffuse { reflectance },
+                Some(texture) => BsdfDesc::Textured {
+                    base: Box::new(BsdfDesc::Diffuse {
+                        reflectance: texture.mean(),
+                    }),
+                    diffuse: texture,
+                },
                 None => BsdfDesc::Diffuse {
                     reflectance: self.reflectance(&props, "reflectance", 0.5)?,
                 },
@@ -149,10 +154,14 @@ impl Builder<'_> {
             }
             "plastic" | "roughplastic" => {
                 let ior = ior_pair(&props, IOR_POLYPROPYLENE, true)?;
-                let diffuse_reflectance = self.reflectance(&props, "diffuse_reflectance", 0.5)?;
+                let texture = self.texture_param(&props, "diffuse_reflectance")?;
+                let diffuse_reflectance = match &texture {
+                    Some(t) => t.mean(),
+                    None => self.reflectance(&props, "diffuse_reflectance", 0.5)?,
+                };
                 let specular_reflectance = self.reflectance(&props, "specular_reflectance", 1.0)?;
                 let nonlinear = props.boolean("nonlinear")?.unwrap_or(false);
-                if kind == "plastic" {
+                let plastic = if kind == "plastic" {
                     BsdfDesc::Plastic {
                         ior,
                         diffuse_reflectance,
@@ -167,6 +176,13 @@ impl Builder<'_> {
                         roughness: self.roughness(&props, false)?,
                         nonlinear,
                     }
+                };
+                match texture {
+                    Some(diffuse) => BsdfDesc::Textured {
+                        base: Box::new(plastic),
+                        diffuse,
+                    },
+                    None => plastic,
                 }
             }
             "twosided" => self.twosided(&props)?,

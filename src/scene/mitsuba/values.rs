@@ -194,8 +194,11 @@ impl<'a> Props<'a> {
         // mltbench reads a texture only as a diffuse BSDF's reflectance (`textures.rs`).
         let takes_texture = |name: &Option<String>| {
             tree.tag(owner) == "bsdf"
-                && tree.type_of(owner) == "diffuse"
-                && name.as_deref() == Some("reflectance")
+                && matches!(
+                    (tree.type_of(owner), name.as_deref()),
+                    ("diffuse", Some("reflectance"))
+                        | ("plastic" | "roughplastic", Some("diffuse_reflectance"))
+                )
         };
         for object in &objects {
             if tree.tag(object.target) == "texture" && !takes_texture(&object.name) {
@@ -203,7 +206,8 @@ impl<'a> Props<'a> {
                     object.via,
                     format!(
                         "{} as \"{}\" of {}: mltbench reads textures only as a diffuse \
-                         BSDF's reflectance (use a constant <rgb> or <spectrum>)",
+                         reflectance (diffuse's reflectance, plastic's and roughplastic's \
+                         diffuse_reflectance; use a constant <rgb> or <spectrum>)",
                         tree.describe(object.target),
                         object.name.as_deref().unwrap_or(""),
                         tree.describe(owner)
