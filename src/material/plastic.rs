@@ -28,6 +28,9 @@ pub struct Plastic {
     pub nonlinear: bool,
     /// R_d / (1 − F_dr,int) or R_d / (1 − R_d F_dr,int), precomputed.
     diffuse_scaled: Rgb,
+    /// F_dr,int: the interface's diffuse reflectance from inside (a quadrature, kept so that
+    /// a textured plastic need not integrate it again at every hit).
+    fdr_int: f32,
     inv_eta2: f32,
     /// s̄ / (s̄ + d̄).
     specular_weight: f32,
@@ -47,6 +50,7 @@ impl Plastic {
             specular_reflectance: specular,
             nonlinear,
             diffuse_scaled: internal_scattering(diffuse, fdr_int, nonlinear),
+            fdr_int,
             inv_eta2: 1.0 / (eta * eta),
             specular_weight: lobe_weight(specular, diffuse),
         }
@@ -55,10 +59,9 @@ impl Plastic {
     /// The same plastic with diffuse reflectance `diffuse` (a texture's value at a point).
     /// The lobe-selection weight stays: Mitsuba 3 sets it once, from the texture's mean.
     pub fn with_diffuse_reflectance(&self, diffuse: Rgb) -> Self {
-        let fdr_int = diffuse_fresnel_reflectance(1.0 / self.eta);
         Plastic {
             diffuse_reflectance: diffuse,
-            diffuse_scaled: internal_scattering(diffuse, fdr_int, self.nonlinear),
+            diffuse_scaled: internal_scattering(diffuse, self.fdr_int, self.nonlinear),
             ..self.clone()
         }
     }
