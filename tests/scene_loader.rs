@@ -2055,8 +2055,8 @@ fn unsupported_features_say_so() {
         ("<shape type=\"instance\"/>", "<shape type=\"instance\">"),
         ("<bsdf type=\"principled\"/>", "<bsdf type=\"principled\">"),
         (
-            "<shape type=\"rectangle\"><bsdf type=\"diffuse\"><texture type=\"bitmap\" name=\"reflectance\"/></bsdf></shape>",
-            "<texture type=\"bitmap\" name=\"reflectance\">",
+            "<shape type=\"rectangle\"><bsdf type=\"conductor\"><texture type=\"bitmap\" name=\"specular_reflectance\"/></bsdf></shape>",
+            "<texture type=\"bitmap\" name=\"specular_reflectance\">",
         ),
         (
             "<shape type=\"rectangle\"><medium type=\"homogeneous\" name=\"interior\"/></shape>",

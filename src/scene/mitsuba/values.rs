@@ -205,9 +205,10 @@ impl<'a> Props<'a> {
                 return Err(tree.error(
                     object.via,
                     format!(
-                        "{} as \"{}\" of {}: mltbench reads textures only as a diffuse \
-                         reflectance (diffuse's reflectance, plastic's and roughplastic's \
-                         diffuse_reflectance; use a constant <rgb> or <spectrum>)",
+                        "{} as \"{}\" of {}: not supported yet; mltbench reads textures \
+                         only as a diffuse reflectance (diffuse's reflectance, plastic's and \
+                         roughplastic's diffuse_reflectance; use a constant <rgb> or \
+                         <spectrum>)",
                         tree.describe(object.target),
                         object.name.as_deref().unwrap_or(""),
                         tree.describe(owner)
