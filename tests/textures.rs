@@ -295,13 +295,16 @@ fn textured_plane(dir: &Path, bsdf: &str) -> Scene {
     Scene::build(load_written(dir, &text).unwrap()).unwrap()
 }
 
+/// A reflectance (its three channels' bit patterns) and the pixels that see only it.
+type PixelGroup = ([u64; 3], Vec<(u32, u32)>);
+
 /// Groups the pixels whose whole footprint on the plane has one reflectance, as
 /// `reflectance(u, v)` gives it (None to skip a point), by that reflectance.
 fn pixels_by_reflectance(
     scene: &Scene,
     reflectance: impl Fn(f64, f64) -> Option<[u64; 3]>,
-) -> Vec<([u64; 3], Vec<(u32, u32)>)> {
-    let mut groups: Vec<([u64; 3], Vec<(u32, u32)>)> = Vec::new();
+) -> Vec<PixelGroup> {
+    let mut groups: Vec<PixelGroup> = Vec::new();
     for y in 0..32 {
         for x in 0..32 {
             // The rectangle's uv at the four corners of the pixel: (−1, −1) → (0, 0) and
@@ -373,8 +376,8 @@ fn a_textured_plane_under_a_uniform_sky_shows_texture_times_sky() {
         let image = render(&scene, pt.as_mut(), Budget::Passes(64), |_, _| {}).image;
         for (rho, pixels) in groups {
             assert!(pixels.len() >= 4, "{} pixels", pixels.len());
-            for c in 0..3 {
-                let expected = f64::from_bits(rho[c]) * SKY;
+            for (c, rho_bits) in rho.iter().enumerate() {
+                let expected = f64::from_bits(*rho_bits) * SKY;
                 let (mean, se) = mean_over(&image, &pixels, c);
                 // Plus the f32 film's rounding, for channels that happen to have no variance.
                 let se = se.hypot(2e-5 * expected);
