@@ -7,6 +7,7 @@
 
 pub mod camera_pass;
 pub mod eyelight;
+pub mod lt;
 pub mod params;
 pub mod pt;
 
@@ -41,7 +42,7 @@ pub trait Estimator: Send {
 }
 
 /// Names of the estimators this build knows, for `--help` and error messages.
-pub const ESTIMATOR_NAMES: &[&str] = &["pt", "eyelight"];
+pub const ESTIMATOR_NAMES: &[&str] = &["pt", "lt", "eyelight"];
 
 /// Fails, listing the known names, unless `name` is one of `ESTIMATOR_NAMES`: for commands
 /// to check before they load a scene.
@@ -71,6 +72,11 @@ pub fn create(name: &str, params: &Params, scene: &Scene, seed: u64) -> Result<B
             pt::new(scene, seed, pt::PtSettings::from_params(params, scene)?)?
                 .with_pixel_samples(pixel_samples(params, scene, seed)?),
         ),
+        "lt" => Box::new(lt::new(
+            scene,
+            seed,
+            lt::LtSettings::from_params(params, scene)?,
+        )?),
         _ => return Err(unknown_estimator(name)),
     };
     params.check_all_used(name)?;

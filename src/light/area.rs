@@ -92,6 +92,8 @@ impl AreaLight {
             origin: point.p,
             direction,
             n: point.n,
+            front: point.front,
+            p_error: point.p_error,
             primitive: point.primitive,
             radiance: self.radiance,
             pdf_pos: 1.0 / self.shape.area(),

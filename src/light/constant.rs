@@ -42,6 +42,8 @@ impl ConstantLight {
             origin,
             direction,
             n: direction,
+            front: direction,
+            p_error: Vec3::ZERO,
             primitive: 0,
             radiance: self.radiance,
             pdf_pos,

@@ -56,6 +56,8 @@ impl DirectionalLight {
             origin,
             direction: self.direction,
             n: self.direction,
+            front: self.direction,
+            p_error: Vec3::ZERO,
             primitive: 0,
             radiance: self.irradiance,
             pdf_pos,

@@ -258,6 +258,8 @@ impl EnvmapLight {
             origin,
             direction,
             n: direction,
+            front: direction,
+            p_error: Vec3::ZERO,
             primitive: 0,
             radiance: self.le(wi),
             pdf_pos,

@@ -197,6 +197,12 @@ pub struct EmissionSample {
     pub direction: Vec3,
     /// Surface normal (area lights), `direction` (lights at infinity), zero (point, spot).
     pub n: Vec3,
+    /// The side that emits (area lights: the shading normal's side, as `ShapePoint::front`);
+    /// `n` for the other lights.
+    pub front: Vec3,
+    /// Rounding-error bound on each coordinate of `origin` (area lights), so that rays
+    /// leaving or reaching the point can be offset off its surface; zero for the others.
+    pub p_error: Vec3,
     pub primitive: u32,
     /// Radiance leaving along `direction`; intensity I·f for point and spot lights;
     /// irradiance for directional lights.
@@ -435,6 +441,20 @@ impl Light {
             Light::Constant(l) => l.radiance,
             Light::Envmap(l) => l.le(hit.p),
             Light::Point(_) | Light::Spot(_) | Light::Directional(_) => Rgb::BLACK,
+        }
+    }
+
+    /// What the emission point `e` of `sample_le` sends towards unit direction `w`, for a
+    /// path that leaves it in `w` instead of `e.direction` (light tracing's connection of
+    /// the light to the camera): radiance for area lights (black behind them), intensity
+    /// (times the falloff) for point and spot lights. Lights at infinity: black, since no
+    /// direction but their own leaves their emission disk towards a given point.
+    pub fn emitted_towards(&self, e: &EmissionSample, w: Vec3) -> Rgb {
+        match self {
+            Light::Area(l) if e.front.dot(w) > 0.0 => l.radiance,
+            Light::Point(l) => l.intensity,
+            Light::Spot(l) => l.intensity * l.falloff(w),
+            _ => Rgb::BLACK,
         }
     }
 

@@ -43,6 +43,8 @@ impl PointLight {
             origin: self.position,
             direction: warp::square_to_sphere(u2),
             n: Vec3::ZERO,
+            front: Vec3::ZERO,
+            p_error: Vec3::ZERO,
             primitive: 0,
             radiance: self.intensity,
             pdf_pos: 1.0,

@@ -107,6 +107,8 @@ impl SpotLight {
             origin: self.position,
             direction,
             n: Vec3::ZERO,
+            front: Vec3::ZERO,
+            p_error: Vec3::ZERO,
             primitive: 0,
             radiance: self.intensity * f,
             pdf_pos: 1.0,

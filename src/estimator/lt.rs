@@ -1,0 +1,253 @@
+//! `lt`: light tracing (particle tracing). Paths start on the lights, scatter through the
+//! scene by importance-transport BSDF sampling, and every vertex is joined to the camera;
+//! what reaches it is splatted onto the film where it lands (Veach 1997, §10.2: the
+//! t = 1 strategies only, each with weight 1).
+//!
+//! * A pass traces as many light paths as the film (window) has pixels, so `--spp N`
+//!   means N × pixels paths (DESIGN.md §3). The image is the splats times pixels / paths:
+//!   the camera's importance is normalised over the whole window, so a pixel's share of a
+//!   path's contribution is 1/pixels of its measurement.
+//! * Lights are chosen by power (`LightSet::sample`), a ray leaves the chosen light by
+//!   `Light::sample_le`; the light vertex itself is joined to the camera (the emitter seen
+//!   directly, skipped under `hide_emitters`), then each surface the path meets that has a
+//!   non-delta component.
+//! * `max_depth` counts the segments of the complete path, camera connection included
+//!   (Mitsuba 3's convention: 1 = emitters seen directly); Russian roulette as `pt`, from
+//!   the vertex where the light path has `rr_depth` segments.
+//! * What light tracing cannot see, by construction: emitters at infinity seen directly,
+//!   and whatever the camera sees through a delta reflection or refraction (a mirror, glass)
+//!   or a `null` surface, since the connection to the camera is a shadow ray and delta
+//!   components give 0 for it. On such scenes `lt` and `pt` differ by those paths.
+//! * Determinism: paths are cut into fixed blocks, each path seeds its own random stream
+//!   from (seed, pass, path index), and the blocks' splats merge in block order, so the
+//!   image does not depend on the thread count.
+
+use glam::Vec2;
+use rayon::prelude::*;
+
+use super::pt::PtSettings;
+use super::{Estimator, Stats};
+use crate::error::Result;
+use crate::film::{Film, SplatList};
+use crate::geometry::Ray;
+use crate::geometry::offset::offset_ray_origin;
+use crate::image::Image;
+use crate::material::TransportMode;
+use crate::path::camera_connection::{self, CameraSplat, adjoint_shading_factor};
+use crate::sampler::{IndependentSampler, Sampler};
+use crate::scene::Scene;
+
+/// `lt` reads the same settings as `pt`: `max_depth`, `rr_depth`, `hide_emitters`.
+pub type LtSettings = PtSettings;
+
+/// Light paths per block: the unit of parallel work and of the merge order.
+const PATHS_PER_BLOCK: u64 = 4096;
+
+/// Tags the light-path streams, so that they never coincide with a camera estimator's
+/// per-pixel streams of the same seed.
+const STREAM_TAG: u32 = 0x4C54_0000;
+
+/// The `lt` estimator.
+pub struct LightTracer {
+    film: Film,
+    seed: u64,
+    settings: LtSettings,
+    stats: Stats,
+    /// Light paths per pass: the film window's pixel count.
+    paths_per_pass: u64,
+    /// One splat list per block, kept across passes.
+    blocks: Vec<SplatList>,
+}
+
+/// Makes `lt` for `scene` with `settings`; an error when its film does not fit in memory.
+pub fn new(scene: &Scene, seed: u64, settings: LtSettings) -> Result<LightTracer> {
+    let film = &scene.description.sensor.film;
+    let window = film.window();
+    let paths_per_pass = window.width as u64 * window.height as u64;
+    Ok(LightTracer {
+        film: Film::new(window.width, window.height, film.filter)?,
+        seed,
+        settings,
+        stats: Stats::default(),
+        paths_per_pass,
+        blocks: Vec::new(),
+    })
+}
+
+/// What one block of paths counted.
+#[derive(Clone, Copy, Default)]
+struct BlockCounts {
+    rays: u64,
+    invalid: u64,
+}
+
+impl LightTracer {
+    /// Traces light path number `index` of pass `pass`, recording its splats.
+    fn trace(
+        &self,
+        scene: &Scene,
+        sampler: &mut IndependentSampler,
+        splats: &mut SplatList,
+        counts: &mut BlockCounts,
+    ) {
+        let max_depth = self.settings.max_depth.unwrap_or(u32::MAX);
+        if max_depth == 0 {
+            return;
+        }
+        let has_lens = scene.camera.has_lens();
+        // The lens point of each connection (a pinhole draws none).
+        let lens_sample = |s: &mut IndependentSampler| {
+            if has_lens { s.next_2d() } else { Vec2::ZERO }
+        };
+        let Some((index, pmf, _)) = scene.lights.sample(sampler.next_1d()) else {
+            return;
+        };
+        let light = scene.lights.get(index);
+        let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
+        let Some(e) = light.sample_le(u_pos, u_dir) else {
+            return;
+        };
+
+        // s = 1: the light seen by the camera (a path of one segment).
+        let u_lens = lens_sample(sampler);
+        if !self.settings.hide_emitters
+            && let Some(splat) = camera_connection::connect_emitter(scene, light, pmf, &e, u_lens)
+        {
+            self.record(scene, &splat, splats, counts);
+        }
+
+        // The emitted ray's throughput Le |cos θ| / (p_light p_pos p_dir); no cosine for
+        // point and spot lights, and |n·ω| = 1 for lights at infinity (n = ω).
+        let cos = if e.delta_pos {
+            1.0
+        } else {
+            e.n.dot(e.direction).abs()
+        };
+        let mut beta = e.radiance * (cos / (pmf * e.pdf_pos * e.pdf_dir));
+        let origin = offset_ray_origin(e.origin, e.p_error, e.n, e.direction);
+        let mut ray = Ray::new(origin, e.direction);
+        let mut eta = 1.0f32;
+        // Segments of the light path so far, the one being traced included.
+        let mut depth = 1u32;
+        loop {
+            counts.rays += 1;
+            let Some(si) = scene.geometry.intersect(&ray) else {
+                break;
+            };
+            // Joining `si` to the camera makes a path of depth + 1 segments.
+            if depth >= max_depth {
+                break;
+            }
+            let wo = -ray.d.normalize();
+            let bsdf = &*scene.bsdf_at(&si);
+            let frame = si.frame();
+            if bsdf.has_non_delta() {
+                let u_lens = lens_sample(sampler);
+                if let Some(splat) =
+                    camera_connection::connect_surface(scene, &si, &frame, bsdf, wo, beta, u_lens)
+                {
+                    self.record(scene, &splat, splats, counts);
+                }
+            }
+
+            // The next segment, by importance-transport BSDF sampling.
+            let u_lobe = sampler.next_1d();
+            let u = sampler.next_2d();
+            let Some(bs) = bsdf.sample(frame.to_local(wo), u_lobe, u, TransportMode::Importance)
+            else {
+                break;
+            };
+            let wi = frame.to_world(bs.wi);
+            beta *= bs.weight * adjoint_shading_factor(wo, wi, si.ns, si.ng);
+            eta *= bs.eta;
+            ray = si.spawn_ray(wi);
+            depth += 1;
+
+            // Russian roulette, as `pt`.
+            let max_beta = beta.max_component();
+            if max_beta <= 0.0 || !max_beta.is_finite() {
+                break;
+            }
+            if depth > self.settings.rr_depth {
+                let q = (max_beta * eta * eta).min(0.95);
+                if sampler.next_1d() >= q {
+                    break;
+                }
+                beta /= q;
+            }
+        }
+    }
+
+    /// Casts `splat`'s shadow ray and keeps it if the camera sees its vertex; a value that
+    /// is NaN, infinite or negative is dropped and counted instead.
+    fn record(
+        &self,
+        scene: &Scene,
+        splat: &CameraSplat,
+        splats: &mut SplatList,
+        counts: &mut BlockCounts,
+    ) {
+        if !splat.value.is_valid_radiance() {
+            counts.invalid += 1;
+            return;
+        }
+        counts.rays += 1;
+        if !scene.geometry.occluded(&splat.shadow) {
+            splats.push(splat.raster, splat.value);
+        }
+    }
+}
+
+impl Estimator for LightTracer {
+    fn name(&self) -> &str {
+        "lt"
+    }
+
+    fn run_pass(&mut self, scene: &Scene, pass_index: u32) {
+        let n = self.paths_per_pass;
+        let block_count = n.div_ceil(PATHS_PER_BLOCK) as usize;
+        let mut blocks = std::mem::take(&mut self.blocks);
+        blocks.resize_with(block_count, SplatList::new);
+        let counts: Vec<BlockCounts> = blocks
+            .par_iter_mut()
+            .enumerate()
+            .map(|(b, splats)| {
+                splats.clear();
+                let mut counts = BlockCounts::default();
+                let mut sampler = IndependentSampler::new(self.seed);
+                let first = b as u64 * PATHS_PER_BLOCK;
+                for path in first..(first + PATHS_PER_BLOCK).min(n) {
+                    // A stream per (pass, path): the pixel-sample key with the path index
+                    // in place of the pixel.
+                    let key = (
+                        (path & 0xFFFF_FFFF) as u32,
+                        STREAM_TAG | (path >> 32) as u32,
+                    );
+                    sampler.start_pixel_sample(key, pass_index as u64);
+                    self.trace(scene, &mut sampler, splats, &mut counts);
+                }
+                counts
+            })
+            .collect();
+        for (splats, c) in blocks.iter().zip(&counts) {
+            self.film.merge_splats(splats);
+            self.stats.rays += c.rays;
+            self.stats.invalid_samples += c.invalid;
+        }
+        self.blocks = blocks;
+        self.stats.passes += 1;
+        self.stats.samples += n;
+    }
+
+    fn image(&self) -> Image {
+        if self.stats.samples == 0 {
+            return self.film.image(0.0);
+        }
+        let pixels = self.film.width() as f64 * self.film.height() as f64;
+        self.film.image(pixels / self.stats.samples as f64)
+    }
+
+    fn stats(&self) -> Stats {
+        self.stats.clone()
+    }
+}
