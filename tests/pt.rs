@@ -44,19 +44,6 @@ fn pixel_sees_only(scene: &Scene, x: u32, y: u32, shape: u32) -> bool {
         })
 }
 
-fn furnace(shape: &str, albedo: &str, le: &str, max_depth: i32, inside: &str) -> Scene {
-    scene(&format!(
-        r#"<scene version="3.0.0">
-            <integrator type="path"><integer name="max_depth" value="{max_depth}"/></integrator>
-            {camera}
-            {}
-            {inside}
-        </scene>"#,
-        enclosure(shape, albedo, le),
-        camera = camera()
-    ))
-}
-
 #[test]
 fn furnace_truncated_sums_for_each_max_depth() {
     let (a, le) = (0.8f64, 1.0f64);

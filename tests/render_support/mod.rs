@@ -240,3 +240,16 @@ pub fn assert_floor_under_the_cbox_light(
     }
     assert!(checked >= 4, "{checked} pixels inside the window");
 }
+
+pub fn furnace(shape: &str, albedo: &str, le: &str, max_depth: i32, inside: &str) -> Scene {
+    scene(&format!(
+        r#"<scene version="3.0.0">
+            <integrator type="path"><integer name="max_depth" value="{max_depth}"/></integrator>
+            {camera}
+            {}
+            {inside}
+        </scene>"#,
+        enclosure(shape, albedo, le),
+        camera = camera()
+    ))
+}

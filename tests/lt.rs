@@ -1,0 +1,350 @@
+//! The light tracer `lt` against closed forms and against `pt` (fixed seeds; tolerances in
+//! standard deviations measured from independent runs):
+//!
+//! * furnace: inside a closed, uniformly emitting diffuse enclosure of albedo a every pixel
+//!   is Le·Σ_{j<d} a^j for `max_depth` d, Le/(1 − a) unbounded, and Le·Σ_{1≤j<d} a^j
+//!   under `hide_emitters` (the emitter seen directly is the s = 1 connection);
+//! * direct illumination of a floor by the Cornell box light matches Lambert's polygon
+//!   formula, also through a crop window (the camera's importance is normalised over the
+//!   window); under a point light and a directional light it follows E = I cos θ / d² and
+//!   E cos θ;
+//! * on the Cornell box, with a pinhole and with a thin lens, every 4×4-pixel block agrees
+//!   with `pt` (Welch's t over 16 runs each, Šidák-corrected over all blocks and channels);
+//! * the image does not depend on the thread count.
+
+mod render_support;
+
+use std::path::Path;
+
+use glam::Vec3;
+use mltbench::estimator::{self, Params};
+use mltbench::image::Image;
+use mltbench::render::{Budget, render};
+use mltbench::scene::{CropWindow, Scene, mitsuba};
+use render_support::*;
+use statrs::distribution::{ContinuousCDF, StudentsT};
+
+fn render_lt(scene: &Scene, params: &[&str], passes: u32, seed: u64) -> Image {
+    render_with("lt", scene, params, passes, seed)
+}
+
+/// Mean over all pixels of channel `c` in each run: their mean and standard error.
+fn image_mean_over_runs(runs: &[Image], c: usize) -> (f64, f64) {
+    let means: Vec<f64> = runs
+        .iter()
+        .map(|im| im.pixels.iter().map(|p| p[c] as f64).sum::<f64>() / im.pixels.len() as f64)
+        .collect();
+    mean_and_standard_error(&means)
+}
+
+fn mean_and_standard_error(values: &[f64]) -> (f64, f64) {
+    let k = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / k;
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (k - 1.0);
+    (mean, (var / k).sqrt())
+}
+
+/// `runs` light-tracing renders of `scene` with `passes` passes each, seeds from `seed`.
+fn lt_runs(scene: &Scene, params: &[&str], runs: u64, passes: u32, seed: u64) -> Vec<Image> {
+    (0..runs)
+        .map(|k| render_lt(scene, params, passes, seed + k))
+        .collect()
+}
+
+#[test]
+fn furnace_truncated_sums_for_each_max_depth() {
+    let (a, le) = (0.8f64, 1.0f64);
+    for shape in ["cube", "sphere"] {
+        for depth in [1, 2, 3, 5, -1] {
+            let scene = furnace(shape, "0.8", "1", depth, "");
+            let runs = lt_runs(&scene, &[], 8, 32, 40 + depth as u64);
+            let expected: f64 = if depth < 0 {
+                le / (1.0 - a)
+            } else {
+                (0..depth).map(|j| le * a.powi(j)).sum()
+            };
+            for c in 0..3 {
+                assert_within_sigmas(
+                    &format!("{shape} furnace, max_depth {depth}, channel {c}"),
+                    image_mean_over_runs(&runs, c),
+                    expected,
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn hide_emitters_leaves_out_the_emitter_seen_directly() {
+    let (a, le) = (0.5f64, 2.0f64);
+    for depth in [1, 2, 4] {
+        let scene = furnace("sphere", "0.5", "2", depth, "");
+        let runs = lt_runs(&scene, &["hide_emitters=true"], 8, 8, 70 + depth as u64);
+        let expected: f64 = (1..depth).map(|j| le * a.powi(j)).sum();
+        let (mean, se) = image_mean_over_runs(&runs, 1);
+        if depth == 1 {
+            assert_eq!((mean, se), (0.0, 0.0), "nothing but the emitter at depth 1");
+            continue;
+        }
+        assert_within_sigmas(
+            &format!("hidden emitter, max_depth {depth}"),
+            (mean, se),
+            expected,
+        );
+    }
+}
+
+/// `lt` renders the floor under the Cornell box light with 1024 passes per run (a 16×16
+/// film: 256 light paths a pass).
+const LT_FLOOR: (&str, u32) = ("lt", 1024);
+
+#[test]
+fn floor_irradiance_under_a_rectangle_light_matches_lamberts_formula() {
+    assert_floor_under_the_cbox_light(
+        LT_FLOOR,
+        CBOX_LIGHT_RECTANGLE,
+        Path::new("test-scene.xml"),
+        None,
+    );
+}
+
+#[test]
+fn a_crop_window_shows_the_floor_where_the_full_film_does() {
+    // Light paths per pass follow the window's pixel count, and the camera's importance is
+    // normalised over the window: both must hold for the cropped pixels to match.
+    assert_floor_under_the_cbox_light(
+        LT_FLOOR,
+        CBOX_LIGHT_RECTANGLE,
+        Path::new("test-scene.xml"),
+        Some(CropWindow {
+            x: 2,
+            y: 3,
+            width: 12,
+            height: 10,
+        }),
+    );
+}
+
+/// Floor pixels (`floor_camera`) of albedo `rho` against ρ/π · E(p) averaged over each
+/// pixel's footprint, with pixel means over 16 runs.
+fn assert_floor_follows(scene: &Scene, rho: f64, irradiance: impl Fn(Vec3) -> f64, seed: u64) {
+    let runs = lt_runs(scene, &[], 16, 512, seed);
+    for (x, y) in [(8, 8), (2, 3), (14, 12), (5, 13)] {
+        let expected = floor_pixel_average(scene, x, y, &irradiance) * rho / std::f64::consts::PI;
+        assert_within_sigmas(
+            &format!("floor pixel ({x},{y})"),
+            mean_over_runs(&runs, x, y, 0),
+            expected,
+        );
+    }
+}
+
+#[test]
+fn floor_under_a_point_light_follows_the_inverse_square_law() {
+    let (rho, intensity, light) = (0.5f64, 4.0f64, Vec3::new(0.3, 0.5, -0.2));
+    let scene = scene(&format!(
+        r#"<scene version="3.0.0">
+            <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+            {floor_camera}
+            <emitter type="point"><point name="position" x="0.3" y="0.5" z="-0.2"/>
+                <rgb name="intensity" value="4"/></emitter>
+            {floor}
+        </scene>"#,
+        floor_camera = floor_camera(),
+        floor = floor(0.5)
+    ));
+    let irradiance = |p: Vec3| {
+        let d = light - p;
+        intensity * (d.y / d.length()) as f64 / d.length_squared() as f64
+    };
+    assert_floor_follows(&scene, rho, irradiance, 300);
+}
+
+#[test]
+fn floor_under_a_directional_light_receives_e_cos_theta() {
+    // A light at infinity: paths start on a disk outside the scene (density 1/πR²).
+    let (rho, e) = (0.7f64, 3.0f64);
+    let towards = Vec3::new(0.3, -1.0, 0.2).normalize();
+    let scene = scene(&format!(
+        r#"<scene version="3.0.0">
+            <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+            {floor_camera}
+            <emitter type="directional"><vector name="direction" x="0.3" y="-1" z="0.2"/>
+                <rgb name="irradiance" value="3"/></emitter>
+            {floor}
+        </scene>"#,
+        floor_camera = floor_camera(),
+        floor = floor(0.7)
+    ));
+    assert_floor_follows(&scene, rho, |_| e * (-towards.y) as f64, 500);
+}
+
+/// A shipped scene at `res` × `res` pixels.
+fn shipped_scene(file: &str, res: u32) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("experiments/scenes")
+        .join(file);
+    let params = [("res".to_string(), res.to_string())];
+    Scene::build(mitsuba::load_file_with(&path, &params).unwrap()).unwrap()
+}
+
+/// Per run, the mean of each `BLOCK`×`BLOCK` block of pixels, per channel:
+/// `[block][channel]`.
+fn block_means(image: &Image) -> Vec<[f64; 3]> {
+    const BLOCK: u32 = 4;
+    let mut out = Vec::new();
+    for by in 0..image.height / BLOCK {
+        for bx in 0..image.width / BLOCK {
+            let mut sum = [0.0f64; 3];
+            for y in by * BLOCK..(by + 1) * BLOCK {
+                for x in bx * BLOCK..(bx + 1) * BLOCK {
+                    let p = image.get(x, y);
+                    for (c, s) in sum.iter_mut().enumerate() {
+                        *s += p[c] as f64;
+                    }
+                }
+            }
+            out.push(sum.map(|s| s / (BLOCK * BLOCK) as f64));
+        }
+    }
+    out
+}
+
+/// Welch's t-test of every block and channel between the runs of two estimators: the
+/// smallest two-sided p-value and how many tests there were.
+fn smallest_block_p_value(a: &[Image], b: &[Image]) -> (f64, usize, String) {
+    let (ma, mb): (Vec<_>, Vec<_>) = (
+        a.iter().map(block_means).collect(),
+        b.iter().map(block_means).collect(),
+    );
+    let mut smallest = (1.0f64, String::new());
+    let blocks = ma[0].len();
+    for k in 0..blocks {
+        for c in 0..3 {
+            let xa: Vec<f64> = ma.iter().map(|r| r[k][c]).collect();
+            let xb: Vec<f64> = mb.iter().map(|r| r[k][c]).collect();
+            let ((mean_a, se_a), (mean_b, se_b)) =
+                (mean_and_standard_error(&xa), mean_and_standard_error(&xb));
+            let (va, vb) = (se_a * se_a, se_b * se_b);
+            if va + vb == 0.0 {
+                assert_eq!(mean_a, mean_b, "block {k} channel {c}: both exact");
+                continue;
+            }
+            let t = (mean_a - mean_b) / (va + vb).sqrt();
+            // Welch–Satterthwaite degrees of freedom.
+            let (na, nb) = (xa.len() as f64 - 1.0, xb.len() as f64 - 1.0);
+            let dof = (va + vb).powi(2) / (va * va / na + vb * vb / nb);
+            let p = 2.0 * StudentsT::new(0.0, 1.0, dof).unwrap().cdf(-t.abs());
+            if p < smallest.0 {
+                smallest = (
+                    p,
+                    format!("block {k} channel {c}: {mean_a:.5} against {mean_b:.5} (t = {t:.2})"),
+                );
+            }
+        }
+    }
+    (smallest.0, blocks * 3, smallest.1)
+}
+
+#[test]
+fn agrees_with_pt_on_the_cornell_box_block_by_block() {
+    // Every block and channel is one test; at family-wise significance 10⁻³ (Šidák over
+    // all 192 of them) none may differ. Diffuse walls only, so both estimators see the
+    // same paths: the emitter seen directly, and every bounce up to max_depth 8.
+    for (file, seed) in [("cbox.xml", 1000), ("cbox-dof.xml", 2000)] {
+        let scene = shipped_scene(file, 32);
+        let lt: Vec<Image> = lt_runs(&scene, &[], 16, 64, seed);
+        let pt: Vec<Image> = (0..16)
+            .map(|k| render_with("pt", &scene, &[], 16, seed + 100 + k))
+            .collect();
+        let (p, tests, worst) = smallest_block_p_value(&lt, &pt);
+        let per_test = 1.0 - (1.0f64 - 1e-3).powf(1.0 / tests as f64);
+        eprintln!(
+            "{file}: smallest p {p:.2e} over {tests} tests (threshold {per_test:.2e}); {worst}"
+        );
+        assert!(
+            p > per_test,
+            "{file}: {worst}, p = {p:.2e} < {per_test:.2e}"
+        );
+        // And the whole image: both means within 4 σ.
+        for c in 0..3 {
+            let (a, sa) = image_mean_over_runs(&lt, c);
+            let (b, sb) = image_mean_over_runs(&pt, c);
+            let z = (a - b) / sa.hypot(sb);
+            assert!(
+                z.abs() < SIGMAS,
+                "{file} channel {c}: {a} against {b}, {z:.2} σ"
+            );
+        }
+    }
+}
+
+#[test]
+fn leaning_vertex_normals_on_the_receiver_give_what_pt_gives() {
+    // A floor whose interpolated normals lean away from its geometric normal, under the
+    // Cornell box light (direct lighting). Light tracing reaches the same pixel values as
+    // path tracing only through the adjoint BSDF's shading-normal factor (Veach 1997,
+    // eq. 5.19); without it the floor is off by |wo·ns| |wi·ng| / (|wo·ng| |wi·ns|).
+    let dir = std::env::temp_dir().join(format!("mltbench-lt-lean-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("floor.obj"),
+        "v -1 -1 1\nv 1 -1 1\nv 1 -1 -1\nv -1 -1 -1\n\
+         vn -0.6 1 0.3\nvn 0.5 1 0.6\nvn 0.4 1 -0.5\nvn -0.3 1 -0.6\n\
+         f 1//1 2//2 3//3\nf 1//1 3//3 4//4\n",
+    )
+    .unwrap();
+    let xml = format!(
+        r#"<scene version="3.0.0">
+            <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+            {floor_camera}
+            {CBOX_LIGHT_RECTANGLE}
+                <bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>
+                <emitter type="area"><rgb name="radiance" value="10"/></emitter>
+            </shape>
+            <shape type="obj"><string name="filename" value="floor.obj"/>
+                <bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf>
+            </shape>
+        </scene>"#,
+        floor_camera = floor_camera()
+    );
+    let desc = mitsuba::load_str(&xml, &dir.join("scene.xml")).expect("scene loads");
+    let scene = Scene::build(desc).expect("scene builds");
+    let lt = lt_runs(&scene, &[], 16, 512, 800);
+    let pt: Vec<Image> = (0..16)
+        .map(|k| render_with("pt", &scene, &[], 16, 900 + k))
+        .collect();
+    let (p, tests, worst) = smallest_block_p_value(&lt, &pt);
+    let per_test = 1.0 - (1.0f64 - 1e-3).powf(1.0 / tests as f64);
+    eprintln!("leaning normals: smallest p {p:.2e} over {tests} tests; {worst}");
+    assert!(p > per_test, "{worst}, p = {p:.2e} < {per_test:.2e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn one_and_two_threads_give_bit_identical_images() {
+    let scene = shipped_scene("cbox-spheres.xml", 40);
+    let with_threads = |threads: usize, seed: u64| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut lt = estimator::create("lt", &Params::default(), &scene, seed).unwrap();
+        pool.install(|| render(&scene, lt.as_mut(), Budget::Passes(3), |_, _| {}))
+            .image
+    };
+    let bits = |im: &Image| -> Vec<u32> {
+        im.pixels
+            .iter()
+            .flat_map(|p| p.0.map(f32::to_bits))
+            .collect()
+    };
+    let one = with_threads(1, 5);
+    assert_eq!(bits(&one), bits(&with_threads(2, 5)));
+    assert!(one.pixels.iter().any(|p| !p.is_black()));
+    assert_ne!(
+        bits(&one),
+        bits(&with_threads(2, 6)),
+        "another seed, another image"
+    );
+}
