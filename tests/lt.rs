@@ -7,7 +7,7 @@
 //! * direct illumination of a floor by the Cornell box light matches Lambert's polygon
 //!   formula, also through a crop window (the camera's importance is normalised over the
 //!   window); under a point light and a directional light it follows E = I cos θ / d² and
-//!   E cos θ;
+//!   E cos θ; point and spot lights are invisible to the camera, as in `pt`;
 //! * on the Cornell box, with a pinhole and with a thin lens, every 4×4-pixel block agrees
 //!   with `pt` (Welch's t over 16 runs each, Šidák-corrected over all blocks and channels);
 //! * the image does not depend on the thread count.
@@ -158,6 +158,34 @@ fn floor_under_a_point_light_follows_the_inverse_square_law() {
         intensity * (d.y / d.length()) as f64 / d.length_squared() as f64
     };
     assert_floor_follows(&scene, rho, irradiance, 300);
+}
+
+#[test]
+fn point_and_spot_lights_are_invisible_to_the_camera() {
+    // As in pt (camera rays never hit a delta light) and Mitsuba 3: a lamp in front of the
+    // camera, lighting only a wall behind the camera, leaves the image black.
+    for emitter in [
+        r#"<emitter type="point"><point name="position" x="0" y="0" z="-2"/>
+            <rgb name="intensity" value="5"/></emitter>"#,
+        r#"<emitter type="spot"><transform name="to_world">
+            <lookat origin="0,0,-2" target="0,0,0" up="0,1,0"/></transform>
+            <rgb name="intensity" value="5"/></emitter>"#,
+    ] {
+        let scene = scene(&format!(
+            r#"<scene version="3.0.0">{camera}{emitter}{behind}</scene>"#,
+            camera = camera(),
+            // Something to light, out of the camera's view.
+            behind = r#"<shape type="rectangle"><transform name="to_world">
+                <translate z="5"/></transform></shape>"#
+        ));
+        for name in ["lt", "pt"] {
+            let image = render_with(name, &scene, &[], 4, 3);
+            assert!(
+                image.pixels.iter().all(|p| p.is_black()),
+                "{name}: {emitter}"
+            );
+        }
+    }
 }
 
 #[test]

@@ -14,6 +14,8 @@
 //! * `max_depth` counts the segments of the complete path, camera connection included
 //!   (Mitsuba 3's convention: 1 = emitters seen directly); Russian roulette as `pt`, from
 //!   the vertex where the light path has `rr_depth` segments.
+//! * Point and spot lights are invisible to the camera, as in `pt` and Mitsuba 3 (whose
+//!   camera rays never hit them); only the light they send into the scene counts.
 //! * What light tracing cannot see, by construction: emitters at infinity seen directly,
 //!   and whatever the camera sees through a delta reflection or refraction (a mirror, glass)
 //!   or a `null` surface, since the connection to the camera is a shadow ray and delta

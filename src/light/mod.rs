@@ -445,10 +445,10 @@ impl Light {
     }
 
     /// What the emission point `e` of `sample_le` sends towards unit direction `w`, for a
-    /// path that leaves it in `w` instead of `e.direction` (light tracing's connection of
-    /// the light to the camera): radiance for area lights (black behind them), intensity
-    /// (times the falloff) for point and spot lights. Lights at infinity: black, since no
-    /// direction but their own leaves their emission disk towards a given point.
+    /// path that leaves it in `w` instead of `e.direction` (connecting the light to another
+    /// vertex): radiance for area lights (black behind them), intensity (times the falloff)
+    /// for point and spot lights. Lights at infinity: black, since no direction but their
+    /// own leaves their emission disk towards a given point.
     pub fn emitted_towards(&self, e: &EmissionSample, w: Vec3) -> Rgb {
         match self {
             Light::Area(l) if e.front.dot(w) > 0.0 => l.radiance,

@@ -50,8 +50,10 @@ pub fn adjoint_shading_factor(wo: Vec3, wi: Vec3, ns: Vec3, ng: Vec3) -> f32 {
 /// The light vertex itself seen by the camera (s = 1: the path light → camera): `e` was
 /// emitted by `light`, chosen with probability `pmf`. `u_lens` picks the lens point of a
 /// thin lens (ignored by a pinhole). None for lights at infinity and delta directions
-/// (they cannot reach a point camera), and when the point lies outside the image or the
-/// light faces away.
+/// (they cannot reach a point camera), when the point lies outside the image or the light
+/// faces away, and for point and spot lights: camera rays never hit those, so in `pt` and
+/// in Mitsuba 3 they are invisible, and light tracing keeps that convention (otherwise the
+/// pixel that sees one would hold its whole irradiance at the camera).
 pub fn connect_emitter(
     scene: &Scene,
     light: &Light,
@@ -59,18 +61,14 @@ pub fn connect_emitter(
     e: &EmissionSample,
     u_lens: Vec2,
 ) -> Option<CameraSplat> {
-    if light.is_infinite() || e.delta_dir {
+    if light.is_infinite() || e.delta_dir || e.delta_pos {
         return None;
     }
     let c = scene.camera.connect_lens(e.origin, u_lens)?;
     let emitted = light.emitted_towards(e, c.direction_to_camera);
-    // Area lights: the geometric cosine at the light turns its area density into the
-    // solid angle the camera sees; point and spot lights have none (n = 0).
-    let cos = if e.delta_pos {
-        1.0
-    } else {
-        e.n.dot(c.direction_to_camera).abs()
-    };
+    // The geometric cosine at the light turns its area density into the solid angle the
+    // camera sees.
+    let cos = e.n.dot(c.direction_to_camera).abs();
     let value = emitted * (cos * c.importance / (pmf * e.pdf_pos));
     if value.is_black() {
         return None;
