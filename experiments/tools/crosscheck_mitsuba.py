@@ -479,8 +479,13 @@ def parse_args(argv):
     )
     p.add_argument("--keep", type=Path, metavar="DIR", help="keep the EXR images in DIR")
     p.add_argument("--csv", type=Path, metavar="FILE", help="append one row per comparison")
-    # Debug: test the plumbing with another mltbench estimator (e.g. eyelight).
-    p.add_argument("--estimator", default="pt", help=argparse.SUPPRESS)
+    p.add_argument(
+        "--estimator",
+        default="pt",
+        help="mltbench estimator to render with (default pt; lt compares light tracing "
+        "against Mitsuba's integrator, which agrees on scenes without specular surfaces "
+        "seen by the camera or environment emitters in view)",
+    )
     args = p.parse_args(argv)
     if args.spp_list:
         try:
