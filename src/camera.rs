@@ -222,6 +222,16 @@ impl Camera {
         self.clipped_ray(self.to_world.point(a), d_camera)
     }
 
+    /// The camera point a ray of `generate_ray` or `sample_ray` leaves from: the pinhole,
+    /// or its point of the lens (the ray's origin moved back from the near clip plane).
+    pub fn ray_start(&self, ray: &Ray) -> Vec3 {
+        if self.lens.is_none() {
+            return self.position;
+        }
+        let dz = self.to_world.inverse.transform_vector3(ray.d).z;
+        ray.o - ray.d * (self.near_clip / dz)
+    }
+
     /// The ray from world point `origin` (on the camera plane z = 0) along the unit
     /// camera-space direction `d_camera`, cut to the clip planes z = near and z = far.
     fn clipped_ray(&self, origin: Vec3, d_camera: Vec3) -> Ray {

@@ -22,26 +22,9 @@ use mltbench::image::Image;
 use mltbench::render::{Budget, render};
 use mltbench::scene::{CropWindow, Scene, mitsuba};
 use render_support::*;
-use statrs::distribution::{ContinuousCDF, StudentsT};
 
 fn render_lt(scene: &Scene, params: &[&str], passes: u32, seed: u64) -> Image {
     render_with("lt", scene, params, passes, seed)
-}
-
-/// Mean over all pixels of channel `c` in each run: their mean and standard error.
-fn image_mean_over_runs(runs: &[Image], c: usize) -> (f64, f64) {
-    let means: Vec<f64> = runs
-        .iter()
-        .map(|im| im.pixels.iter().map(|p| p[c] as f64).sum::<f64>() / im.pixels.len() as f64)
-        .collect();
-    mean_and_standard_error(&means)
-}
-
-fn mean_and_standard_error(values: &[f64]) -> (f64, f64) {
-    let k = values.len() as f64;
-    let mean = values.iter().sum::<f64>() / k;
-    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (k - 1.0);
-    (mean, (var / k).sqrt())
 }
 
 /// `runs` light-tracing renders of `scene` with `passes` passes each, seeds from `seed`.
@@ -207,73 +190,6 @@ fn floor_under_a_directional_light_receives_e_cos_theta() {
     assert_floor_follows(&scene, rho, |_| e * (-towards.y) as f64, 500);
 }
 
-/// A shipped scene at `res` × `res` pixels.
-fn shipped_scene(file: &str, res: u32) -> Scene {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("experiments/scenes")
-        .join(file);
-    let params = [("res".to_string(), res.to_string())];
-    Scene::build(mitsuba::load_file_with(&path, &params).unwrap()).unwrap()
-}
-
-/// Per run, the mean of each `BLOCK`×`BLOCK` block of pixels, per channel:
-/// `[block][channel]`.
-fn block_means(image: &Image) -> Vec<[f64; 3]> {
-    const BLOCK: u32 = 4;
-    let mut out = Vec::new();
-    for by in 0..image.height / BLOCK {
-        for bx in 0..image.width / BLOCK {
-            let mut sum = [0.0f64; 3];
-            for y in by * BLOCK..(by + 1) * BLOCK {
-                for x in bx * BLOCK..(bx + 1) * BLOCK {
-                    let p = image.get(x, y);
-                    for (c, s) in sum.iter_mut().enumerate() {
-                        *s += p[c] as f64;
-                    }
-                }
-            }
-            out.push(sum.map(|s| s / (BLOCK * BLOCK) as f64));
-        }
-    }
-    out
-}
-
-/// Welch's t-test of every block and channel between the runs of two estimators: the
-/// smallest two-sided p-value and how many tests there were.
-fn smallest_block_p_value(a: &[Image], b: &[Image]) -> (f64, usize, String) {
-    let (ma, mb): (Vec<_>, Vec<_>) = (
-        a.iter().map(block_means).collect(),
-        b.iter().map(block_means).collect(),
-    );
-    let mut smallest = (1.0f64, String::new());
-    let blocks = ma[0].len();
-    for k in 0..blocks {
-        for c in 0..3 {
-            let xa: Vec<f64> = ma.iter().map(|r| r[k][c]).collect();
-            let xb: Vec<f64> = mb.iter().map(|r| r[k][c]).collect();
-            let ((mean_a, se_a), (mean_b, se_b)) =
-                (mean_and_standard_error(&xa), mean_and_standard_error(&xb));
-            let (va, vb) = (se_a * se_a, se_b * se_b);
-            if va + vb == 0.0 {
-                assert_eq!(mean_a, mean_b, "block {k} channel {c}: both exact");
-                continue;
-            }
-            let t = (mean_a - mean_b) / (va + vb).sqrt();
-            // Welch–Satterthwaite degrees of freedom.
-            let (na, nb) = (xa.len() as f64 - 1.0, xb.len() as f64 - 1.0);
-            let dof = (va + vb).powi(2) / (va * va / na + vb * vb / nb);
-            let p = 2.0 * StudentsT::new(0.0, 1.0, dof).unwrap().cdf(-t.abs());
-            if p < smallest.0 {
-                smallest = (
-                    p,
-                    format!("block {k} channel {c}: {mean_a:.5} against {mean_b:.5} (t = {t:.2})"),
-                );
-            }
-        }
-    }
-    (smallest.0, blocks * 3, smallest.1)
-}
-
 #[test]
 fn agrees_with_pt_on_the_cornell_box_block_by_block() {
     // Every block and channel is one test; at family-wise significance 10⁻³ (Šidák over
@@ -285,15 +201,7 @@ fn agrees_with_pt_on_the_cornell_box_block_by_block() {
         let pt: Vec<Image> = (0..16)
             .map(|k| render_with("pt", &scene, &[], 16, seed + 100 + k))
             .collect();
-        let (p, tests, worst) = smallest_block_p_value(&lt, &pt);
-        let per_test = 1.0 - (1.0f64 - 1e-3).powf(1.0 / tests as f64);
-        eprintln!(
-            "{file}: smallest p {p:.2e} over {tests} tests (threshold {per_test:.2e}); {worst}"
-        );
-        assert!(
-            p > per_test,
-            "{file}: {worst}, p = {p:.2e} < {per_test:.2e}"
-        );
+        assert_blocks_agree(file, &lt, &pt);
         // And the whole image: both means within 4 σ.
         for c in 0..3 {
             let (a, sa) = image_mean_over_runs(&lt, c);
@@ -342,10 +250,7 @@ fn leaning_vertex_normals_on_the_receiver_give_what_pt_gives() {
     let pt: Vec<Image> = (0..16)
         .map(|k| render_with("pt", &scene, &[], 16, 900 + k))
         .collect();
-    let (p, tests, worst) = smallest_block_p_value(&lt, &pt);
-    let per_test = 1.0 - (1.0f64 - 1e-3).powf(1.0 / tests as f64);
-    eprintln!("leaning normals: smallest p {p:.2e} over {tests} tests; {worst}");
-    assert!(p > per_test, "{worst}, p = {p:.2e} < {per_test:.2e}");
+    assert_blocks_agree("leaning normals", &lt, &pt);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

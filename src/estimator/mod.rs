@@ -5,6 +5,7 @@
 //! do not depend on the thread count, so a (scene, estimator, parameters, seed, passes)
 //! tuple always gives the same bits.
 
+pub mod bdpt;
 pub mod camera_pass;
 pub mod eyelight;
 pub mod lt;
@@ -42,7 +43,7 @@ pub trait Estimator: Send {
 }
 
 /// Names of the estimators this build knows, for `--help` and error messages.
-pub const ESTIMATOR_NAMES: &[&str] = &["pt", "lt", "eyelight"];
+pub const ESTIMATOR_NAMES: &[&str] = &["pt", "lt", "bdpt", "eyelight"];
 
 /// Fails, listing the known names, unless `name` is one of `ESTIMATOR_NAMES`: for commands
 /// to check before they load a scene.
@@ -77,6 +78,10 @@ pub fn create(name: &str, params: &Params, scene: &Scene, seed: u64) -> Result<B
             seed,
             lt::LtSettings::from_params(params, scene)?,
         )?),
+        "bdpt" => Box::new(
+            bdpt::new(scene, seed, bdpt::BdptSettings::from_params(params, scene)?)?
+                .with_pixel_samples(pixel_samples(params, scene, seed)?),
+        ),
         _ => return Err(unknown_estimator(name)),
     };
     params.check_all_used(name)?;

@@ -29,6 +29,8 @@ pub struct CameraSplat {
     pub value: Rgb,
     /// From the light-subpath vertex to the camera point, stopping short of it.
     pub shadow: Ray,
+    /// The camera point joined: the pinhole, or the sampled point of the lens.
+    pub camera_position: Vec3,
 }
 
 /// The adjoint BSDF's shading-normal factor |wo·ns| |wi·ng| / (|wo·ng| |wi·ns|) for a light
@@ -82,6 +84,7 @@ pub fn connect_emitter(
             d: c.camera_position - o,
             t_max: 1.0 - SHADOW_EPSILON,
         },
+        camera_position: c.camera_position,
     })
 }
 
@@ -117,5 +120,6 @@ pub fn connect_surface(
         raster: c.raster,
         value,
         shadow: si.spawn_ray_to(c.camera_position),
+        camera_position: c.camera_position,
     })
 }

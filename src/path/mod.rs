@@ -1,6 +1,9 @@
 //! The path space module: what every estimator shares about building and weighting paths
-//! (DESIGN.md §2). So far: multiple-importance-sampling weights, and the joining of a light
-//! subpath's vertex to the camera (light tracing's strategies).
+//! (DESIGN.md §2): path vertices with their area densities, the random walk that makes
+//! subpaths, the joining of a light subpath's vertex to the camera (light tracing's
+//! strategies), and multiple-importance-sampling weights.
 
 pub mod camera_connection;
 pub mod mis;
+pub mod random_walk;
+pub mod vertex;

@@ -11,6 +11,7 @@ use mltbench::estimator::{self, Params};
 use mltbench::image::Image;
 use mltbench::render::{Budget, render};
 use mltbench::scene::{CropWindow, Scene, mitsuba};
+use statrs::distribution::{ContinuousCDF, StudentsT};
 
 /// Standard deviations allowed before a test fails.
 pub const SIGMAS: f64 = 4.0;
@@ -252,4 +253,99 @@ pub fn furnace(shape: &str, albedo: &str, le: &str, max_depth: i32, inside: &str
         enclosure(shape, albedo, le),
         camera = camera()
     ))
+}
+
+/// Mean over all pixels of channel `c` in each run: their mean and standard error.
+pub fn image_mean_over_runs(runs: &[Image], c: usize) -> (f64, f64) {
+    let means: Vec<f64> = runs
+        .iter()
+        .map(|im| im.pixels.iter().map(|p| p[c] as f64).sum::<f64>() / im.pixels.len() as f64)
+        .collect();
+    mean_and_standard_error(&means)
+}
+
+pub fn mean_and_standard_error(values: &[f64]) -> (f64, f64) {
+    let k = values.len() as f64;
+    let mean = values.iter().sum::<f64>() / k;
+    let var = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / (k - 1.0);
+    (mean, (var / k).sqrt())
+}
+
+/// A shipped scene at `res` × `res` pixels.
+pub fn shipped_scene(file: &str, res: u32) -> Scene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("experiments/scenes")
+        .join(file);
+    let params = [("res".to_string(), res.to_string())];
+    Scene::build(mitsuba::load_file_with(&path, &params).unwrap()).unwrap()
+}
+
+/// Per run, the mean of each `BLOCK`×`BLOCK` block of pixels, per channel:
+/// `[block][channel]`.
+pub fn block_means(image: &Image) -> Vec<[f64; 3]> {
+    const BLOCK: u32 = 4;
+    let mut out = Vec::new();
+    for by in 0..image.height / BLOCK {
+        for bx in 0..image.width / BLOCK {
+            let mut sum = [0.0f64; 3];
+            for y in by * BLOCK..(by + 1) * BLOCK {
+                for x in bx * BLOCK..(bx + 1) * BLOCK {
+                    let p = image.get(x, y);
+                    for (c, s) in sum.iter_mut().enumerate() {
+                        *s += p[c] as f64;
+                    }
+                }
+            }
+            out.push(sum.map(|s| s / (BLOCK * BLOCK) as f64));
+        }
+    }
+    out
+}
+
+/// Welch's t-test of every block and channel between the runs of two estimators: the
+/// smallest two-sided p-value and how many tests there were.
+pub fn smallest_block_p_value(a: &[Image], b: &[Image]) -> (f64, usize, String) {
+    let (ma, mb): (Vec<_>, Vec<_>) = (
+        a.iter().map(block_means).collect(),
+        b.iter().map(block_means).collect(),
+    );
+    let mut smallest = (1.0f64, String::new());
+    let blocks = ma[0].len();
+    for k in 0..blocks {
+        for c in 0..3 {
+            let xa: Vec<f64> = ma.iter().map(|r| r[k][c]).collect();
+            let xb: Vec<f64> = mb.iter().map(|r| r[k][c]).collect();
+            let ((mean_a, se_a), (mean_b, se_b)) =
+                (mean_and_standard_error(&xa), mean_and_standard_error(&xb));
+            let (va, vb) = (se_a * se_a, se_b * se_b);
+            if va + vb == 0.0 {
+                assert_eq!(mean_a, mean_b, "block {k} channel {c}: both exact");
+                continue;
+            }
+            let t = (mean_a - mean_b) / (va + vb).sqrt();
+            // Welch–Satterthwaite degrees of freedom.
+            let (na, nb) = (xa.len() as f64 - 1.0, xb.len() as f64 - 1.0);
+            let dof = (va + vb).powi(2) / (va * va / na + vb * vb / nb);
+            let p = 2.0 * StudentsT::new(0.0, 1.0, dof).unwrap().cdf(-t.abs());
+            if p < smallest.0 {
+                smallest = (
+                    p,
+                    format!("block {k} channel {c}: {mean_a:.5} against {mean_b:.5} (t = {t:.2})"),
+                );
+            }
+        }
+    }
+    (smallest.0, blocks * 3, smallest.1)
+}
+
+/// Asserts that no 4×4 block and channel differs between the runs `a` and `b` of two
+/// estimators at family-wise significance 10⁻³ (Šidák over all blocks and channels).
+pub fn assert_blocks_agree(what: &str, a: &[Image], b: &[Image]) {
+    let (p, tests, worst) = smallest_block_p_value(a, b);
+    let per_test = 1.0 - (1.0f64 - 1e-3).powf(1.0 / tests as f64);
+    eprintln!("{what}: smallest p {p:.2e} over {tests} tests (threshold {per_test:.2e}); {worst}");
+    assert!(
+        p > per_test,
+        "{what}: {worst}, p = {p:.2e} < {per_test:.2e}"
+    );
 }
