@@ -476,6 +476,17 @@ impl Film {
         self.invalid_samples
     }
 
+    /// The current estimate when the splats came from `light_paths` light paths: each
+    /// path's splats estimate the measurement of the whole image (the camera's importance
+    /// is normalised over it), so a pixel's share is the splats × pixels / paths.
+    pub fn image_with_light_paths(&self, light_paths: u64) -> Image {
+        if light_paths == 0 {
+            return self.image(0.0);
+        }
+        let pixels = self.width as f64 * self.height as f64;
+        self.image(pixels / light_paths as f64)
+    }
+
     /// The current estimate: filtered pixel values plus the splats times `splat_scale`.
     pub fn image(&self, splat_scale: f64) -> Image {
         let mut image = Image::new(self.width, self.height);

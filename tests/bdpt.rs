@@ -22,7 +22,7 @@ use glam::Vec3;
 use mltbench::estimator::{self, Params};
 use mltbench::image::Image;
 use mltbench::render::{Budget, render};
-use mltbench::scene::{CropWindow, Scene, mitsuba};
+use mltbench::scene::{CropWindow, Scene};
 use render_support::*;
 
 fn runs(
@@ -159,35 +159,10 @@ fn agrees_with_pt_block_by_block_on_the_cornell_boxes() {
 fn leaning_vertex_normals_give_what_pt_gives() {
     // A floor whose interpolated normals lean away from its geometric normal: connections
     // between the subpaths need the adjoint's shading-normal factor on the light side.
-    let dir = std::env::temp_dir().join(format!("mltbench-bdpt-lean-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(
-        dir.join("floor.obj"),
-        "v -1 -1 1\nv 1 -1 1\nv 1 -1 -1\nv -1 -1 -1\n\
-         vn -0.6 1 0.3\nvn 0.5 1 0.6\nvn 0.4 1 -0.5\nvn -0.3 1 -0.6\n\
-         f 1//1 2//2 3//3\nf 1//1 3//3 4//4\n",
-    )
-    .unwrap();
-    let xml = format!(
-        r#"<scene version="3.0.0">
-            <integrator type="path"><integer name="max_depth" value="4"/></integrator>
-            {floor_camera}
-            {CBOX_LIGHT_RECTANGLE}
-                <bsdf type="diffuse"><rgb name="reflectance" value="0.5"/></bsdf>
-                <emitter type="area"><rgb name="radiance" value="10"/></emitter>
-            </shape>
-            <shape type="obj"><string name="filename" value="floor.obj"/>
-                <bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf>
-            </shape>
-        </scene>"#,
-        floor_camera = floor_camera()
-    );
-    let desc = mitsuba::load_str(&xml, &dir.join("scene.xml")).expect("scene loads");
-    let scene = Scene::build(desc).expect("scene builds");
+    let scene = leaning_floor_scene("bdpt-lean", 4, 0.5);
     let bdpt = runs("bdpt", &scene, &[], 16, 64, 800);
     let pt = runs("pt", &scene, &[], 16, 64, 900);
     assert_blocks_agree("leaning normals", &bdpt, &pt);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

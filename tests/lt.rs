@@ -20,7 +20,7 @@ use glam::Vec3;
 use mltbench::estimator::{self, Params};
 use mltbench::image::Image;
 use mltbench::render::{Budget, render};
-use mltbench::scene::{CropWindow, Scene, mitsuba};
+use mltbench::scene::{CropWindow, Scene};
 use render_support::*;
 
 fn render_lt(scene: &Scene, params: &[&str], passes: u32, seed: u64) -> Image {
@@ -221,37 +221,12 @@ fn leaning_vertex_normals_on_the_receiver_give_what_pt_gives() {
     // Cornell box light (direct lighting). Light tracing reaches the same pixel values as
     // path tracing only through the adjoint BSDF's shading-normal factor (Veach 1997,
     // eq. 5.19); without it the floor is off by |wo·ns| |wi·ng| / (|wo·ng| |wi·ns|).
-    let dir = std::env::temp_dir().join(format!("mltbench-lt-lean-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    std::fs::write(
-        dir.join("floor.obj"),
-        "v -1 -1 1\nv 1 -1 1\nv 1 -1 -1\nv -1 -1 -1\n\
-         vn -0.6 1 0.3\nvn 0.5 1 0.6\nvn 0.4 1 -0.5\nvn -0.3 1 -0.6\n\
-         f 1//1 2//2 3//3\nf 1//1 3//3 4//4\n",
-    )
-    .unwrap();
-    let xml = format!(
-        r#"<scene version="3.0.0">
-            <integrator type="path"><integer name="max_depth" value="2"/></integrator>
-            {floor_camera}
-            {CBOX_LIGHT_RECTANGLE}
-                <bsdf type="diffuse"><rgb name="reflectance" value="0"/></bsdf>
-                <emitter type="area"><rgb name="radiance" value="10"/></emitter>
-            </shape>
-            <shape type="obj"><string name="filename" value="floor.obj"/>
-                <bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf>
-            </shape>
-        </scene>"#,
-        floor_camera = floor_camera()
-    );
-    let desc = mitsuba::load_str(&xml, &dir.join("scene.xml")).expect("scene loads");
-    let scene = Scene::build(desc).expect("scene builds");
+    let scene = leaning_floor_scene("lt-lean", 2, 0.0);
     let lt = lt_runs(&scene, &[], 16, 512, 800);
     let pt: Vec<Image> = (0..16)
         .map(|k| render_with("pt", &scene, &[], 16, 900 + k))
         .collect();
     assert_blocks_agree("leaning normals", &lt, &pt);
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]

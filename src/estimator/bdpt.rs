@@ -21,7 +21,6 @@ use rayon::prelude::*;
 
 use super::pt::PtSettings;
 use super::{Estimator, Params, Stats};
-use crate::camera::raster_in_pixel;
 use crate::error::{Error, Result};
 use crate::film::{Film, FilmTile, SplatList};
 use crate::geometry::Ray;
@@ -38,7 +37,7 @@ use crate::sampler::pixel_samples::{CameraSampler, PixelSamples};
 use crate::scene::Scene;
 use std::sync::Arc;
 
-use super::camera_pass::TILE_SIZE;
+use super::camera_pass::{TILE_SIZE, start_camera_sample};
 
 /// Which heuristic weighs the strategies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -554,13 +553,8 @@ impl Estimator for Bdpt {
                 let mut paths = (Vec::new(), Vec::new());
                 for y in rect.y0..rect.y1 {
                     for x in rect.x0..rect.x1 {
-                        sampler.start_pixel_sample((x, y), pass_index as u64);
-                        let raster = raster_in_pixel(x, y, sampler.next_2d());
-                        let ray = if camera.has_lens() {
-                            camera.sample_ray(raster, sampler.next_2d())
-                        } else {
-                            camera.generate_ray(raster)
-                        };
+                        let (raster, ray) =
+                            start_camera_sample(camera, &mut sampler, x, y, pass_index);
                         let value = self.sample(scene, ray, &mut sampler, &mut paths, &mut out);
                         if value.is_valid_radiance() {
                             out.tile.add_sample(raster, value);
@@ -583,11 +577,8 @@ impl Estimator for Bdpt {
     }
 
     fn image(&self) -> Image {
-        if self.stats.samples == 0 {
-            return self.film.image(0.0);
-        }
-        let pixels = self.film.width() as f64 * self.film.height() as f64;
-        self.film.image(pixels / self.stats.samples as f64)
+        // One light subpath per camera sample.
+        self.film.image_with_light_paths(self.stats.samples)
     }
 
     fn stats(&self) -> Stats {

@@ -7,12 +7,13 @@
 use rayon::prelude::*;
 
 use super::{Estimator, Stats};
-use crate::camera::raster_in_pixel;
+use crate::camera::{Camera, raster_in_pixel};
 use crate::error::Result;
 use crate::film::{Film, FilmTile};
 use crate::geometry::Ray;
 use crate::image::Image;
 use crate::math::Rgb;
+use glam::Vec2;
 use std::sync::Arc;
 
 use crate::sampler::Sampler;
@@ -57,15 +58,7 @@ pub fn camera_pass(
                 .with_lens_samples(camera.has_lens());
             for y in rect.y0..rect.y1 {
                 for x in rect.x0..rect.x1 {
-                    sampler.start_pixel_sample((x, y), pass_index as u64);
-                    // The pixel position, then (only for a lens) the lens sample: the first
-                    // two 2D samples of the pixel sample (`CameraSampler`).
-                    let raster = raster_in_pixel(x, y, sampler.next_2d());
-                    let ray = if camera.has_lens() {
-                        camera.sample_ray(raster, sampler.next_2d())
-                    } else {
-                        camera.generate_ray(raster)
-                    };
+                    let (raster, ray) = start_camera_sample(camera, &mut sampler, x, y, pass_index);
                     let (value, rays) = estimate.radiance(scene, &ray, &mut sampler);
                     counts.samples += 1;
                     counts.rays += rays;
@@ -87,6 +80,26 @@ pub fn camera_pass(
         total.invalid += counts.invalid;
     }
     total
+}
+
+/// Starts sample `pass_index` of pixel (x, y): the raster position and the camera ray. The
+/// pixel position, then (only for a lens) the lens sample are the first two 2D samples of
+/// the pixel sample (`CameraSampler`).
+pub fn start_camera_sample(
+    camera: &Camera,
+    sampler: &mut CameraSampler,
+    x: u32,
+    y: u32,
+    pass_index: u32,
+) -> (Vec2, Ray) {
+    sampler.start_pixel_sample((x, y), pass_index as u64);
+    let raster = raster_in_pixel(x, y, sampler.next_2d());
+    let ray = if camera.has_lens() {
+        camera.sample_ray(raster, sampler.next_2d())
+    } else {
+        camera.generate_ray(raster)
+    };
+    (raster, ray)
 }
 
 /// An estimator that takes one camera sample per pixel and pass, computed by `S`

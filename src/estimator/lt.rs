@@ -242,11 +242,7 @@ impl Estimator for LightTracer {
     }
 
     fn image(&self) -> Image {
-        if self.stats.samples == 0 {
-            return self.film.image(0.0);
-        }
-        let pixels = self.film.width() as f64 * self.film.height() as f64;
-        self.film.image(pixels / self.stats.samples as f64)
+        self.film.image_with_light_paths(self.stats.samples)
     }
 
     fn stats(&self) -> Stats {

@@ -349,3 +349,37 @@ pub fn assert_blocks_agree(what: &str, a: &[Image], b: &[Image]) {
         "{what}: {worst}, p = {p:.2e} < {per_test:.2e}"
     );
 }
+
+/// The floor y = −1 as an OBJ quad whose vertex normals lean away from its geometric normal
+/// (diffuse, ρ = 0.6), under the Cornell box light (radiance 10, reflectance
+/// `light_albedo`), seen by `floor_camera`, with `max_depth`. The OBJ goes to a folder named
+/// after `name`.
+pub fn leaning_floor_scene(name: &str, max_depth: u32, light_albedo: f64) -> Scene {
+    let dir = std::env::temp_dir().join(format!("mltbench-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(
+        dir.join("floor.obj"),
+        "v -1 -1 1\nv 1 -1 1\nv 1 -1 -1\nv -1 -1 -1\n\
+         vn -0.6 1 0.3\nvn 0.5 1 0.6\nvn 0.4 1 -0.5\nvn -0.3 1 -0.6\n\
+         f 1//1 2//2 3//3\nf 1//1 3//3 4//4\n",
+    )
+    .unwrap();
+    let xml = format!(
+        r#"<scene version="3.0.0">
+            <integrator type="path"><integer name="max_depth" value="{max_depth}"/></integrator>
+            {floor_camera}
+            {CBOX_LIGHT_RECTANGLE}
+                <bsdf type="diffuse"><rgb name="reflectance" value="{light_albedo}"/></bsdf>
+                <emitter type="area"><rgb name="radiance" value="10"/></emitter>
+            </shape>
+            <shape type="obj"><string name="filename" value="floor.obj"/>
+                <bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf>
+            </shape>
+        </scene>"#,
+        floor_camera = floor_camera()
+    );
+    let desc = mitsuba::load_str(&xml, &dir.join("scene.xml")).expect("scene loads");
+    let scene = Scene::build(desc).expect("scene builds");
+    let _ = std::fs::remove_dir_all(&dir);
+    scene
+}
