@@ -18,7 +18,6 @@ mod render_support;
 
 use std::path::Path;
 
-use glam::Vec3;
 use mltbench::estimator::{self, Params};
 use mltbench::image::Image;
 use mltbench::render::{Budget, render};
@@ -108,25 +107,10 @@ fn floor_irradiance_under_a_rectangle_light_matches_lamberts_formula() {
 
 #[test]
 fn floor_under_a_point_light_follows_the_inverse_square_law() {
-    let (rho, intensity, light) = (0.5f64, 4.0f64, Vec3::new(0.3, 0.5, -0.2));
-    let scene = scene(&format!(
-        r#"<scene version="3.0.0">
-            <integrator type="path"><integer name="max_depth" value="2"/></integrator>
-            {floor_camera}
-            <emitter type="point"><point name="position" x="0.3" y="0.5" z="-0.2"/>
-                <rgb name="intensity" value="4"/></emitter>
-            {floor}
-        </scene>"#,
-        floor_camera = floor_camera(),
-        floor = floor(0.5)
-    ));
+    let (scene, rho, irradiance) = point_light_floor();
     let images = runs("bdpt", &scene, &[], 16, 16, 300);
     for (x, y) in [(8, 8), (2, 3), (14, 12), (5, 13)] {
-        let expected = floor_pixel_average(&scene, x, y, |p| {
-            let d = light - p;
-            intensity * (d.y / d.length()) as f64 / d.length_squared() as f64
-        }) * rho
-            / std::f64::consts::PI;
+        let expected = floor_pixel_average(&scene, x, y, &irradiance) * rho / std::f64::consts::PI;
         assert_within_sigmas(
             &format!("floor pixel ({x},{y})"),
             mean_over_runs(&images, x, y, 0),

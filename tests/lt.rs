@@ -124,22 +124,7 @@ fn assert_floor_follows(scene: &Scene, rho: f64, irradiance: impl Fn(Vec3) -> f6
 
 #[test]
 fn floor_under_a_point_light_follows_the_inverse_square_law() {
-    let (rho, intensity, light) = (0.5f64, 4.0f64, Vec3::new(0.3, 0.5, -0.2));
-    let scene = scene(&format!(
-        r#"<scene version="3.0.0">
-            <integrator type="path"><integer name="max_depth" value="2"/></integrator>
-            {floor_camera}
-            <emitter type="point"><point name="position" x="0.3" y="0.5" z="-0.2"/>
-                <rgb name="intensity" value="4"/></emitter>
-            {floor}
-        </scene>"#,
-        floor_camera = floor_camera(),
-        floor = floor(0.5)
-    ));
-    let irradiance = |p: Vec3| {
-        let d = light - p;
-        intensity * (d.y / d.length()) as f64 / d.length_squared() as f64
-    };
+    let (scene, rho, irradiance) = point_light_floor();
     assert_floor_follows(&scene, rho, irradiance, 300);
 }
 

@@ -383,3 +383,26 @@ pub fn leaning_floor_scene(name: &str, max_depth: u32, light_albedo: f64) -> Sce
     let _ = std::fs::remove_dir_all(&dir);
     scene
 }
+
+/// A floor of albedo 0.5 (`floor`, seen by `floor_camera`) under a point light of
+/// intensity 4 at (0.3, 0.5, −0.2), direct lighting only (`max_depth` 2): the scene, the
+/// albedo, and the irradiance E(p) = I cos θ / d² on the floor.
+pub fn point_light_floor() -> (Scene, f64, impl Fn(Vec3) -> f64) {
+    let (rho, intensity, light) = (0.5f64, 4.0f64, Vec3::new(0.3, 0.5, -0.2));
+    let scene = scene(&format!(
+        r#"<scene version="3.0.0">
+            <integrator type="path"><integer name="max_depth" value="2"/></integrator>
+            {floor_camera}
+            <emitter type="point"><point name="position" x="0.3" y="0.5" z="-0.2"/>
+                <rgb name="intensity" value="4"/></emitter>
+            {floor}
+        </scene>"#,
+        floor_camera = floor_camera(),
+        floor = floor(rho)
+    ));
+    let irradiance = move |p: Vec3| {
+        let d = light - p;
+        intensity * (d.y / d.length()) as f64 / d.length_squared() as f64
+    };
+    (scene, rho, irradiance)
+}
