@@ -116,6 +116,15 @@ struct TileResult {
     splats: SplatList,
     rays: u64,
     invalid: u64,
+    /// Reused by every weight computed in the tile: no allocation per strategy.
+    scratch: WeightScratch,
+}
+
+/// (pdf_fwd, pdf_rev, delta) of the vertices a strategy uses, endpoints replaced.
+#[derive(Default)]
+struct WeightScratch {
+    light: Vec<(f32, f32, bool)>,
+    camera: Vec<(f32, f32, bool)>,
 }
 
 /// The light subpath's first vertex as sampled, kept for the s = 1, t = 1 strategy.
@@ -377,9 +386,11 @@ impl Bdpt {
     /// The multiple-importance weight of strategy (s, t) for the path it made, over every
     /// strategy that could have made it (Veach 1997, §10.3: ratios of the area densities
     /// from either side, delta vertices excluded as connection points).
+    #[allow(clippy::too_many_arguments)]
     fn mis_weight(
         &self,
         scene: &Scene,
+        scratch: &mut WeightScratch,
         light_path: &[Vertex],
         camera_path: &[Vertex],
         sampled: Option<&Sampled>,
@@ -389,8 +400,11 @@ impl Bdpt {
         // (pdf_fwd, pdf_rev, delta) of the vertices this strategy uses, endpoints replaced
         // by what the strategy sampled.
         let state = |v: &Vertex| (v.pdf_fwd, v.pdf_rev, v.delta);
-        let mut lv: Vec<(f32, f32, bool)> = light_path[..s].iter().map(state).collect();
-        let mut cv: Vec<(f32, f32, bool)> = camera_path[..t].iter().map(state).collect();
+        let (lv, cv) = (&mut scratch.light, &mut scratch.camera);
+        lv.clear();
+        lv.extend(light_path[..s].iter().map(state));
+        cv.clear();
+        cv.extend(camera_path[..t].iter().map(state));
         // The strategy's endpoints as vertices (the sampled one where there is one).
         let (qs, pt): (Option<&Vertex>, Option<&Vertex>) = match sampled {
             Some(Sampled {
@@ -506,7 +520,15 @@ impl Bdpt {
                 if c.value.is_black() {
                     continue;
                 }
-                let w = self.mis_weight(scene, light_path, camera_path, c.sampled.as_ref(), s, t);
+                let w = self.mis_weight(
+                    scene,
+                    &mut out.scratch,
+                    light_path,
+                    camera_path,
+                    c.sampled.as_ref(),
+                    s,
+                    t,
+                );
                 let value = c.value * w;
                 if value.is_black() {
                     continue;
@@ -546,6 +568,7 @@ impl Estimator for Bdpt {
                     splats: SplatList::new(),
                     rays: 0,
                     invalid: 0,
+                    scratch: WeightScratch::default(),
                 };
                 let camera = &scene.camera;
                 let mut sampler = CameraSampler::new(self.seed, self.pixel_samples.clone())
