@@ -406,3 +406,32 @@ pub fn point_light_floor() -> (Scene, f64, impl Fn(Vec3) -> f64) {
     };
     (scene, rho, irradiance)
 }
+
+/// Asserts that `estimator` renders the same bits on 1 and 2 threads (`cbox-spheres.xml` at
+/// 40×40, a film whose tiles do not divide it evenly), and another image for another seed.
+pub fn assert_thread_count_does_not_matter(estimator: &str, passes: u32) {
+    let scene = shipped_scene("cbox-spheres.xml", 40);
+    let with_threads = |threads: usize, seed: u64| -> Vec<u32> {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let mut e = estimator::create(estimator, &Params::default(), &scene, seed).unwrap();
+        let image = pool
+            .install(|| render(&scene, e.as_mut(), Budget::Passes(passes), |_, _| {}))
+            .image;
+        assert!(image.pixels.iter().any(|p| !p.is_black()), "{estimator}");
+        image
+            .pixels
+            .iter()
+            .flat_map(|p| p.0.map(f32::to_bits))
+            .collect()
+    };
+    let one = with_threads(1, 5);
+    assert_eq!(one, with_threads(2, 5), "{estimator}: 1 and 2 threads");
+    assert_ne!(
+        one,
+        with_threads(2, 6),
+        "{estimator}: another seed, another image"
+    );
+}
