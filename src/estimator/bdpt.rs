@@ -24,13 +24,12 @@ use super::{Estimator, Params, Stats};
 use crate::error::{Error, Result};
 use crate::film::{Film, FilmTile, SplatList};
 use crate::geometry::Ray;
-use crate::geometry::offset::offset_ray_origin;
 use crate::image::Image;
 use crate::light::{EmissionSample, LightPoint};
 use crate::material::TransportMode;
 use crate::math::Rgb;
 use crate::path::camera_connection::{self, adjoint_shading_factor};
-use crate::path::random_walk::{WalkLimits, random_walk};
+use crate::path::random_walk::{WalkLimits, emitted_ray, random_walk};
 use crate::path::vertex::{Vertex, VertexKind};
 use crate::sampler::Sampler;
 use crate::sampler::pixel_samples::{CameraSampler, PixelSamples};
@@ -209,16 +208,7 @@ impl Bdpt {
             e.radiance,
             pmf * e.pdf_pos,
         ));
-        let cos = if e.delta_pos {
-            1.0
-        } else {
-            e.n.dot(e.direction).abs()
-        };
-        let beta = e.radiance * (cos / (pmf * e.pdf_pos * e.pdf_dir));
-        let ray = Ray::new(
-            offset_ray_origin(e.origin, e.p_error, e.n, e.direction),
-            e.direction,
-        );
+        let (ray, beta) = emitted_ray(&e, pmf);
         let limits = WalkLimits {
             max_vertices: self.max_depth().saturating_sub(1),
             rr_depth: self.settings.path.rr_depth,

@@ -31,11 +31,10 @@ use super::pt::PtSettings;
 use super::{Estimator, Stats};
 use crate::error::Result;
 use crate::film::{Film, SplatList};
-use crate::geometry::Ray;
-use crate::geometry::offset::offset_ray_origin;
 use crate::image::Image;
 use crate::material::TransportMode;
 use crate::path::camera_connection::{self, CameraSplat, adjoint_shading_factor};
+use crate::path::random_walk::emitted_ray;
 use crate::sampler::{IndependentSampler, Sampler};
 use crate::scene::Scene;
 
@@ -118,16 +117,7 @@ impl LightTracer {
             self.record(scene, &splat, splats, counts);
         }
 
-        // The emitted ray's throughput Le |cos θ| / (p_light p_pos p_dir); no cosine for
-        // point and spot lights, and |n·ω| = 1 for lights at infinity (n = ω).
-        let cos = if e.delta_pos {
-            1.0
-        } else {
-            e.n.dot(e.direction).abs()
-        };
-        let mut beta = e.radiance * (cos / (pmf * e.pdf_pos * e.pdf_dir));
-        let origin = offset_ray_origin(e.origin, e.p_error, e.n, e.direction);
-        let mut ray = Ray::new(origin, e.direction);
+        let (mut ray, mut beta) = emitted_ray(&e, pmf);
         let mut eta = 1.0f32;
         // Segments of the light path so far, the one being traced included.
         let mut depth = 1u32;

@@ -1,12 +1,29 @@
 //! The random walk both subpaths of a bidirectional estimator are made of (DESIGN.md §2).
 
 use crate::geometry::Ray;
+use crate::geometry::offset::offset_ray_origin;
+use crate::light::EmissionSample;
 use crate::material::TransportMode;
 use crate::math::Rgb;
 use crate::path::camera_connection::adjoint_shading_factor;
 use crate::path::vertex::{Vertex, VertexKind};
 use crate::sampler::Sampler;
 use crate::scene::Scene;
+
+/// The start of a light walk: the ray leaving emission sample `e` of a light chosen with
+/// probability `pmf` (its origin offset off an area light's surface), and its throughput
+/// Le |cos θ| / (p_light p_pos p_dir). Point and spot lights have no cosine; for lights at
+/// infinity n = ω, so |n·ω| = 1.
+pub fn emitted_ray(e: &EmissionSample, pmf: f32) -> (Ray, Rgb) {
+    let cos = if e.delta_pos {
+        1.0
+    } else {
+        e.n.dot(e.direction).abs()
+    };
+    let beta = e.radiance * (cos / (pmf * e.pdf_pos * e.pdf_dir));
+    let origin = offset_ray_origin(e.origin, e.p_error, e.n, e.direction);
+    (Ray::new(origin, e.direction), beta)
+}
 
 /// How far a walk may go and when Russian roulette starts.
 #[derive(Clone, Copy, Debug)]
