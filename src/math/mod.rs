@@ -1,6 +1,7 @@
 //! Small math vocabulary shared by every part of mltbench.
 
 pub mod frame;
+pub mod lanes;
 pub mod spectrum;
 pub mod transform;
 pub mod warp;

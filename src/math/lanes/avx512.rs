@@ -1,0 +1,386 @@
+//! The lane types in AVX-512 registers: the same operations as `portable`, one instruction
+//! (or a few) each.
+//!
+//! SAFETY (every `unsafe` block in this file): the module is compiled only when AVX-512F is
+//! enabled for the whole build (`cfg` in `lanes/mod.rs`), so each intrinsic is available;
+//! loads and stores go through arrays of exactly one vector's size, and gathers read only
+//! indices clamped into their slice.
+
+use std::arch::x86_64::*;
+use std::fmt;
+use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Sub};
+
+use super::{Mask8, Mask16};
+
+/// Sixteen f32 lanes.
+#[derive(Clone, Copy)]
+pub struct F32x16(__m512);
+
+/// Sixteen u32 lanes (wrapping arithmetic).
+#[derive(Clone, Copy)]
+pub struct U32x16(__m512i);
+
+/// Eight f64 lanes (half of a sixteen-lane vector, widened).
+#[derive(Clone, Copy)]
+pub struct F64x8(__m512d);
+
+/// Eight u64 lanes (wrapping arithmetic).
+#[derive(Clone, Copy)]
+pub struct U64x8(__m512i);
+
+/// Binary operators that are one intrinsic.
+macro_rules! binary_ops {
+    ($ty:ident, $( $tr:ident $method:ident $intrinsic:ident ),* $(,)?) => {
+        $(
+            impl $tr for $ty {
+                type Output = $ty;
+                #[inline(always)]
+                fn $method(self, o: $ty) -> $ty {
+                    $ty(unsafe { $intrinsic(self.0, o.0) })
+                }
+            }
+        )*
+    };
+}
+
+binary_ops!(F32x16,
+    Add add _mm512_add_ps,
+    Sub sub _mm512_sub_ps,
+    Mul mul _mm512_mul_ps,
+    Div div _mm512_div_ps,
+);
+binary_ops!(U32x16,
+    Add add _mm512_add_epi32,
+    Sub sub _mm512_sub_epi32,
+    BitAnd bitand _mm512_and_si512,
+    BitOr bitor _mm512_or_si512,
+    BitXor bitxor _mm512_xor_si512,
+);
+binary_ops!(F64x8,
+    Add add _mm512_add_pd,
+    Sub sub _mm512_sub_pd,
+    Mul mul _mm512_mul_pd,
+    Div div _mm512_div_pd,
+);
+binary_ops!(U64x8,
+    Add add _mm512_add_epi64,
+    BitAnd bitand _mm512_and_si512,
+    BitOr bitor _mm512_or_si512,
+    BitXor bitxor _mm512_xor_si512,
+);
+
+const SIGN: u32 = 0x8000_0000;
+
+impl Neg for F32x16 {
+    type Output = F32x16;
+    #[inline(always)]
+    fn neg(self) -> F32x16 {
+        F32x16::from_bits(self.to_bits() ^ U32x16::splat(SIGN))
+    }
+}
+
+impl F32x16 {
+    #[inline(always)]
+    pub fn splat(v: f32) -> F32x16 {
+        F32x16(unsafe { _mm512_set1_ps(v) })
+    }
+
+    #[inline(always)]
+    pub fn from_array(a: [f32; 16]) -> F32x16 {
+        F32x16(unsafe { _mm512_loadu_ps(a.as_ptr()) })
+    }
+
+    #[inline(always)]
+    pub fn to_array(self) -> [f32; 16] {
+        let mut a = [0.0f32; 16];
+        unsafe { _mm512_storeu_ps(a.as_mut_ptr(), self.0) };
+        a
+    }
+
+    #[inline(always)]
+    pub fn sqrt(self) -> F32x16 {
+        F32x16(unsafe { _mm512_sqrt_ps(self.0) })
+    }
+
+    #[inline(always)]
+    pub fn abs(self) -> F32x16 {
+        F32x16(unsafe { _mm512_abs_ps(self.0) })
+    }
+
+    /// The magnitude of `self` with the sign of `sign` (`f32::copysign`).
+    #[inline(always)]
+    pub fn copysign(self, sign: F32x16) -> F32x16 {
+        let s = U32x16::splat(SIGN);
+        F32x16::from_bits((self.to_bits() & U32x16::splat(!SIGN)) | (sign.to_bits() & s))
+    }
+
+    /// Lane-wise `if self > o { self } else { o }` (o where either is NaN): `vmaxps`.
+    #[inline(always)]
+    pub fn max_gt(self, o: F32x16) -> F32x16 {
+        F32x16(unsafe { _mm512_max_ps(self.0, o.0) })
+    }
+
+    /// Lane-wise `if self < o { self } else { o }` (o where either is NaN): `vminps`.
+    #[inline(always)]
+    pub fn min_lt(self, o: F32x16) -> F32x16 {
+        F32x16(unsafe { _mm512_min_ps(self.0, o.0) })
+    }
+
+    #[inline(always)]
+    pub fn lt(self, o: F32x16) -> Mask16 {
+        Mask16(unsafe { _mm512_cmp_ps_mask::<_CMP_LT_OQ>(self.0, o.0) })
+    }
+
+    #[inline(always)]
+    pub fn le(self, o: F32x16) -> Mask16 {
+        Mask16(unsafe { _mm512_cmp_ps_mask::<_CMP_LE_OQ>(self.0, o.0) })
+    }
+
+    #[inline(always)]
+    pub fn gt(self, o: F32x16) -> Mask16 {
+        Mask16(unsafe { _mm512_cmp_ps_mask::<_CMP_GT_OQ>(self.0, o.0) })
+    }
+
+    #[inline(always)]
+    pub fn ge(self, o: F32x16) -> Mask16 {
+        Mask16(unsafe { _mm512_cmp_ps_mask::<_CMP_GE_OQ>(self.0, o.0) })
+    }
+
+    #[inline(always)]
+    pub fn eq(self, o: F32x16) -> Mask16 {
+        Mask16(unsafe { _mm512_cmp_ps_mask::<_CMP_EQ_OQ>(self.0, o.0) })
+    }
+
+    /// `!=`: true where either lane is NaN.
+    #[inline(always)]
+    pub fn ne(self, o: F32x16) -> Mask16 {
+        Mask16(unsafe { _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(self.0, o.0) })
+    }
+
+    #[inline(always)]
+    pub fn is_nan(self) -> Mask16 {
+        Mask16(unsafe { _mm512_cmp_ps_mask::<_CMP_UNORD_Q>(self.0, self.0) })
+    }
+
+    #[inline(always)]
+    pub fn is_finite(self) -> Mask16 {
+        self.abs().lt(F32x16::splat(f32::INFINITY))
+    }
+
+    /// Lane-wise `if m { a } else { b }`.
+    #[inline(always)]
+    pub fn select(m: Mask16, a: F32x16, b: F32x16) -> F32x16 {
+        F32x16(unsafe { _mm512_mask_blend_ps(m.0, b.0, a.0) })
+    }
+
+    #[inline(always)]
+    pub fn to_bits(self) -> U32x16 {
+        U32x16(unsafe { _mm512_castps_si512(self.0) })
+    }
+
+    #[inline(always)]
+    pub fn from_bits(b: U32x16) -> F32x16 {
+        F32x16(unsafe { _mm512_castsi512_ps(b.0) })
+    }
+
+    /// `table[idx]` in the lanes of `m` (indices past the end read the last entry), 0
+    /// elsewhere. `table` must not be empty.
+    #[inline(always)]
+    pub fn gather(table: &[f32], idx: U32x16, m: Mask16) -> F32x16 {
+        let last = table.len() - 1;
+        let idx = idx.min(U32x16::splat(last.min(u32::MAX as usize) as u32));
+        F32x16(unsafe {
+            _mm512_mask_i32gather_ps::<4>(_mm512_setzero_ps(), m.0, idx.0, table.as_ptr())
+        })
+    }
+
+    /// Lanes 0–7 and 8–15 widened to f64 (exact).
+    #[inline(always)]
+    pub fn to_f64_halves(self) -> (F64x8, F64x8) {
+        unsafe {
+            let lo = _mm512_castps512_ps256(self.0);
+            let hi = _mm256_castpd_ps(_mm512_extractf64x4_pd::<1>(_mm512_castps_pd(self.0)));
+            (F64x8(_mm512_cvtps_pd(lo)), F64x8(_mm512_cvtps_pd(hi)))
+        }
+    }
+
+    /// Two f64 halves rounded to f32 (`as f32`: to nearest, ties to even).
+    #[inline(always)]
+    pub fn from_f64_halves(lo: F64x8, hi: F64x8) -> F32x16 {
+        unsafe {
+            let lo = _mm256_castps_pd(_mm512_cvtpd_ps(lo.0));
+            let hi = _mm256_castps_pd(_mm512_cvtpd_ps(hi.0));
+            let both = _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(lo), hi);
+            F32x16(_mm512_castpd_ps(both))
+        }
+    }
+}
+
+impl U32x16 {
+    #[inline(always)]
+    pub fn splat(v: u32) -> U32x16 {
+        U32x16(unsafe { _mm512_set1_epi32(v as i32) })
+    }
+
+    #[inline(always)]
+    pub fn from_array(a: [u32; 16]) -> U32x16 {
+        U32x16(unsafe { _mm512_loadu_epi32(a.as_ptr() as *const i32) })
+    }
+
+    #[inline(always)]
+    pub fn to_array(self) -> [u32; 16] {
+        let mut a = [0u32; 16];
+        unsafe { _mm512_storeu_epi32(a.as_mut_ptr() as *mut i32, self.0) };
+        a
+    }
+
+    #[inline(always)]
+    pub fn shl<const N: u32>(self) -> U32x16 {
+        U32x16(unsafe { _mm512_slli_epi32::<N>(self.0) })
+    }
+
+    #[inline(always)]
+    pub fn shr<const N: u32>(self) -> U32x16 {
+        U32x16(unsafe { _mm512_srli_epi32::<N>(self.0) })
+    }
+
+    #[inline(always)]
+    fn min(self, o: U32x16) -> U32x16 {
+        U32x16(unsafe { _mm512_min_epu32(self.0, o.0) })
+    }
+
+    #[inline(always)]
+    pub fn eq(self, o: U32x16) -> Mask16 {
+        Mask16(unsafe { _mm512_cmpeq_epu32_mask(self.0, o.0) })
+    }
+
+    /// Unsigned `<`.
+    #[inline(always)]
+    pub fn lt(self, o: U32x16) -> Mask16 {
+        Mask16(unsafe { _mm512_cmplt_epu32_mask(self.0, o.0) })
+    }
+
+    #[inline(always)]
+    pub fn select(m: Mask16, a: U32x16, b: U32x16) -> U32x16 {
+        U32x16(unsafe { _mm512_mask_blend_epi32(m.0, b.0, a.0) })
+    }
+
+    /// `table[idx]` in the lanes of `m` (indices past the end read the last entry), 0
+    /// elsewhere. `table` must not be empty.
+    #[inline(always)]
+    pub fn gather(table: &[u32], idx: U32x16, m: Mask16) -> U32x16 {
+        let last = table.len() - 1;
+        let idx = idx.min(U32x16::splat(last.min(u32::MAX as usize) as u32));
+        U32x16(unsafe {
+            _mm512_mask_i32gather_epi32::<4>(
+                _mm512_setzero_si512(),
+                m.0,
+                idx.0,
+                table.as_ptr() as *const i32,
+            )
+        })
+    }
+
+    /// Each lane as f32 (`as f32`).
+    #[inline(always)]
+    pub fn to_f32(self) -> F32x16 {
+        F32x16(unsafe { _mm512_cvtepu32_ps(self.0) })
+    }
+}
+
+impl F64x8 {
+    #[inline(always)]
+    pub fn splat(v: f64) -> F64x8 {
+        F64x8(unsafe { _mm512_set1_pd(v) })
+    }
+
+    #[inline(always)]
+    pub fn to_array(self) -> [f64; 8] {
+        let mut a = [0.0f64; 8];
+        unsafe { _mm512_storeu_pd(a.as_mut_ptr(), self.0) };
+        a
+    }
+
+    #[inline(always)]
+    pub fn lt(self, o: F64x8) -> Mask8 {
+        Mask8(unsafe { _mm512_cmp_pd_mask::<_CMP_LT_OQ>(self.0, o.0) })
+    }
+
+    #[inline(always)]
+    pub fn le(self, o: F64x8) -> Mask8 {
+        Mask8(unsafe { _mm512_cmp_pd_mask::<_CMP_LE_OQ>(self.0, o.0) })
+    }
+
+    #[inline(always)]
+    pub fn gt(self, o: F64x8) -> Mask8 {
+        Mask8(unsafe { _mm512_cmp_pd_mask::<_CMP_GT_OQ>(self.0, o.0) })
+    }
+
+    #[inline(always)]
+    pub fn select(m: Mask8, a: F64x8, b: F64x8) -> F64x8 {
+        F64x8(unsafe { _mm512_mask_blend_pd(m.0, b.0, a.0) })
+    }
+}
+
+impl U64x8 {
+    #[inline(always)]
+    pub fn splat(v: u64) -> U64x8 {
+        U64x8(unsafe { _mm512_set1_epi64(v as i64) })
+    }
+
+    #[inline(always)]
+    pub fn from_array(a: [u64; 8]) -> U64x8 {
+        U64x8(unsafe { _mm512_loadu_epi64(a.as_ptr() as *const i64) })
+    }
+
+    #[inline(always)]
+    pub fn to_array(self) -> [u64; 8] {
+        let mut a = [0u64; 8];
+        unsafe { _mm512_storeu_epi64(a.as_mut_ptr() as *mut i64, self.0) };
+        a
+    }
+
+    #[inline(always)]
+    pub fn shl<const N: u32>(self) -> U64x8 {
+        U64x8(unsafe { _mm512_slli_epi64::<N>(self.0) })
+    }
+
+    #[inline(always)]
+    pub fn shr<const N: u32>(self) -> U64x8 {
+        U64x8(unsafe { _mm512_srli_epi64::<N>(self.0) })
+    }
+
+    #[inline(always)]
+    pub fn rotl<const N: i32>(self) -> U64x8 {
+        U64x8(unsafe { _mm512_rol_epi64::<N>(self.0) })
+    }
+
+    #[inline(always)]
+    pub fn select(m: Mask8, a: U64x8, b: U64x8) -> U64x8 {
+        U64x8(unsafe { _mm512_mask_blend_epi64(m.0, b.0, a.0) })
+    }
+}
+
+impl fmt::Debug for F32x16 {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "F32x16({:?})", self.to_array())
+    }
+}
+
+impl fmt::Debug for U32x16 {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "U32x16({:?})", self.to_array())
+    }
+}
+
+impl fmt::Debug for F64x8 {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "F64x8({:?})", self.to_array())
+    }
+}
+
+impl fmt::Debug for U64x8 {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "U64x8({:?})", self.to_array())
+    }
+}
