@@ -9,7 +9,7 @@ use rayon::prelude::*;
 use super::{Estimator, Stats};
 use crate::camera::{Camera, raster_in_pixel};
 use crate::error::Result;
-use crate::film::{Film, FilmTile};
+use crate::film::{Film, FilmTile, PixelRect};
 use crate::geometry::Ray;
 use crate::image::Image;
 use crate::math::Rgb;
@@ -35,6 +35,74 @@ pub struct PassCounts {
 /// and the number of rays it cast.
 pub trait CameraSampleFn: Sync {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut CameraSampler) -> (Rgb, u64);
+
+    /// Tiles that one task renders together (`render_tiles`); 1 unless the estimator keeps
+    /// several paths in flight and wants a longer queue of samples to draw them from.
+    fn tiles_per_task(&self) -> usize {
+        1
+    }
+
+    /// Takes the pass's sample of every pixel of `rects` (consecutive tiles, in order) and
+    /// returns one finished tile with its counts per rect. By default one sample after the
+    /// other (`render_tile`); an estimator may trace them otherwise, but must return the
+    /// tile `render_tile` would (the same samples added in the same order).
+    fn render_tiles(&self, pass: &PassContext, rects: &[PixelRect]) -> Vec<(FilmTile, PassCounts)> {
+        rects
+            .iter()
+            .map(|&rect| render_tile(pass, rect, self))
+            .collect()
+    }
+}
+
+/// What every task of a pass shares.
+pub struct PassContext<'a> {
+    pub scene: &'a Scene,
+    pub film: &'a Film,
+    pub seed: u64,
+    pub pass_index: u32,
+    pub pixel_samples: &'a Arc<PixelSamples>,
+}
+
+impl PassContext<'_> {
+    /// A sampler for this pass's camera samples (lens samples when the camera has a lens).
+    pub fn camera_sampler(&self) -> CameraSampler {
+        CameraSampler::new(self.seed, self.pixel_samples.clone())
+            .with_lens_samples(self.scene.camera.has_lens())
+    }
+}
+
+/// Takes the pass's sample of every pixel of `rect`, row by row, one after the other.
+pub fn render_tile(
+    pass: &PassContext,
+    rect: PixelRect,
+    estimate: &(impl CameraSampleFn + ?Sized),
+) -> (FilmTile, PassCounts) {
+    let mut tile = pass.film.tile(rect);
+    let mut counts = PassCounts::default();
+    let mut sampler = pass.camera_sampler();
+    for y in rect.y0..rect.y1 {
+        for x in rect.x0..rect.x1 {
+            let (raster, ray) =
+                start_camera_sample(&pass.scene.camera, &mut sampler, x, y, pass.pass_index);
+            let (value, rays) = estimate.radiance(pass.scene, &ray, &mut sampler);
+            counts.add_sample(&mut tile, raster, value, rays);
+        }
+    }
+    (tile, counts)
+}
+
+impl PassCounts {
+    /// Counts one finished camera sample and adds it to `tile`, unless it is NaN, infinite
+    /// or negative (then it is counted as invalid and dropped).
+    pub fn add_sample(&mut self, tile: &mut FilmTile, raster: Vec2, value: Rgb, rays: u64) {
+        self.samples += 1;
+        self.rays += rays;
+        if value.is_valid_radiance() {
+            tile.add_sample(raster, value);
+        } else {
+            self.invalid += 1;
+        }
+    }
 }
 
 /// Takes sample number `pass_index` of every pixel and adds it to `film`.
@@ -48,32 +116,19 @@ pub fn camera_pass(
     estimate: &impl CameraSampleFn,
 ) -> PassCounts {
     let rects = film.tiles(TILE_SIZE);
-    let finished: Vec<(FilmTile, PassCounts)> = rects
-        .par_iter()
-        .map(|&rect| {
-            let mut tile = film.tile(rect);
-            let mut counts = PassCounts::default();
-            let camera = &scene.camera;
-            let mut sampler = CameraSampler::new(seed, pixel_samples.clone())
-                .with_lens_samples(camera.has_lens());
-            for y in rect.y0..rect.y1 {
-                for x in rect.x0..rect.x1 {
-                    let (raster, ray) = start_camera_sample(camera, &mut sampler, x, y, pass_index);
-                    let (value, rays) = estimate.radiance(scene, &ray, &mut sampler);
-                    counts.samples += 1;
-                    counts.rays += rays;
-                    if value.is_valid_radiance() {
-                        tile.add_sample(raster, value);
-                    } else {
-                        counts.invalid += 1;
-                    }
-                }
-            }
-            (tile, counts)
-        })
+    let pass = PassContext {
+        scene,
+        film,
+        seed,
+        pass_index,
+        pixel_samples,
+    };
+    let finished: Vec<Vec<(FilmTile, PassCounts)>> = rects
+        .par_chunks(estimate.tiles_per_task().max(1))
+        .map(|batch| estimate.render_tiles(&pass, batch))
         .collect();
     let mut total = PassCounts::default();
-    for (tile, counts) in &finished {
+    for (tile, counts) in finished.iter().flatten() {
         film.merge_tile(tile);
         total.samples += counts.samples;
         total.rays += counts.rays;

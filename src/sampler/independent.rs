@@ -48,10 +48,29 @@ impl IndependentSampler {
     pub fn next_u64(&mut self) -> u64 {
         self.rng.next_u64()
     }
+
+    /// The generator's state (four words), to continue the same stream elsewhere: in a lane
+    /// of `LaneStreams`, or through `with_state`.
+    pub fn state(&self) -> [u64; 4] {
+        let bytes = self.rng.state();
+        std::array::from_fn(|k| u64::from_le_bytes(bytes[8 * k..8 * k + 8].try_into().unwrap()))
+    }
+
+    /// A sampler that continues the stream whose state is `state` (from `state`).
+    pub fn with_state(seed: u64, state: [u64; 4]) -> IndependentSampler {
+        let mut bytes = [0u8; 32];
+        for (k, w) in state.iter().enumerate() {
+            bytes[8 * k..8 * k + 8].copy_from_slice(&w.to_le_bytes());
+        }
+        IndependentSampler {
+            seed,
+            rng: Xoshiro256PlusPlus::from_seed(bytes),
+        }
+    }
 }
 
 /// The top 24 bits of a 64-bit draw as a float in [0, 1): exactly representable, never 1.
-fn to_unit_f32(bits: u64) -> f32 {
+pub(crate) fn to_unit_f32(bits: u64) -> f32 {
     (bits >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
 }
 

@@ -6,6 +6,7 @@
 
 pub mod ccvt;
 pub mod independent;
+pub mod lane_streams;
 pub mod pattern;
 pub mod permutation;
 pub mod pixel_samples;

@@ -196,6 +196,14 @@ impl CameraSampler {
         self.camera_dimensions = if on { 2 } else { 1 };
         self
     }
+
+    /// The state of the independent stream that every draw after the camera's comes from
+    /// (`IndependentSampler::state`): once the pixel (and lens) samples are handed out, a
+    /// `LaneStreams` lane or an `IndependentSampler::with_state` seeded with it continues
+    /// this sampler exactly.
+    pub fn stream_state(&self) -> [u64; 4] {
+        self.rng.state()
+    }
 }
 
 impl Sampler for CameraSampler {

@@ -286,6 +286,16 @@ impl U32x16 {
     pub fn to_f32(self) -> F32x16 {
         F32x16(unsafe { _mm512_cvtepu32_ps(self.0) })
     }
+
+    /// The low 32 bits of each u64 lane of `lo` (lanes 0–7) and `hi` (lanes 8–15).
+    #[inline(always)]
+    pub fn from_u64_halves(lo: U64x8, hi: U64x8) -> U32x16 {
+        unsafe {
+            let lo = _mm512_cvtepi64_epi32(lo.0);
+            let hi = _mm512_cvtepi64_epi32(hi.0);
+            U32x16(_mm512_inserti64x4::<1>(_mm512_castsi256_si512(lo), hi))
+        }
+    }
 }
 
 impl F64x8 {

@@ -287,6 +287,18 @@ impl U32x16 {
     pub fn to_f32(self) -> F32x16 {
         F32x16(self.0.map(|a| a as f32))
     }
+
+    /// The low 32 bits of each u64 lane of `lo` (lanes 0–7) and `hi` (lanes 8–15).
+    #[inline(always)]
+    pub fn from_u64_halves(lo: U64x8, hi: U64x8) -> U32x16 {
+        U32x16(std::array::from_fn(|i| {
+            if i < 8 {
+                lo.0[i] as u32
+            } else {
+                hi.0[i - 8] as u32
+            }
+        }))
+    }
 }
 
 impl F64x8 {

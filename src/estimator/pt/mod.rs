@@ -22,11 +22,16 @@
 use glam::Vec3;
 
 use super::Params;
-use super::camera_pass::{CameraEstimator, CameraSampleFn};
+mod path_lanes;
+mod wavefront;
+
+use super::camera_pass::{CameraEstimator, CameraSampleFn, PassContext, PassCounts, render_tile};
 use crate::error::{Error, Result};
+use crate::film::{FilmTile, PixelRect};
 use crate::geometry::{Ray, SurfaceInteraction};
 use crate::light::LightPoint;
 use crate::material::{Bsdf, TransportMode};
+use crate::math::lanes;
 use crate::math::{Frame, Rgb};
 use crate::path::mis::power_heuristic;
 use crate::sampler::Sampler;
@@ -45,6 +50,10 @@ pub struct PtSettings {
     /// that escape having crossed nothing but `null` surfaces. Emitting surfaces seen
     /// through a `null` surface, anything seen in a mirror, and all light reflected stay.
     pub hide_emitters: bool,
+    /// Trace sixteen paths at a time in SIMD lanes (`wavefront.rs`; the same image bits as
+    /// one at a time, faster where the lanes are AVX-512 registers). The default is on
+    /// where they are (`lanes::NATIVE`), off elsewhere.
+    pub wavefront: bool,
 }
 
 impl PtSettings {
@@ -55,6 +64,7 @@ impl PtSettings {
         let max_depth: i64 = params.get("max_depth", integrator.max_depth as i64)?;
         let rr_depth: u32 = params.get("rr_depth", integrator.rr_depth)?;
         let hide_emitters: bool = params.get("hide_emitters", integrator.hide_emitters)?;
+        let wavefront: bool = params.get("wavefront", lanes::NATIVE)?;
         // The same bounds as the scene's <integrator> (Mitsuba's).
         if max_depth < -1 {
             return Err(Error::usage(format!(
@@ -73,6 +83,7 @@ impl PtSettings {
             max_depth,
             rr_depth,
             hide_emitters,
+            wavefront,
         })
     }
 }
@@ -91,24 +102,66 @@ pub struct PathSample {
 }
 
 /// What the next vertex needs to weight emission found by the BSDF-sampled ray.
-#[derive(Clone, Copy)]
-struct PreviousVertex {
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PreviousVertex {
     /// Emission of a surface this ray hits counts (false only for a camera ray under
     /// `hide_emitters`).
-    shows_emitters: bool,
+    pub shows_emitters: bool,
     /// The environment counts if this ray escapes (under `hide_emitters`, false until the
     /// path has scattered at a surface that is not `null`).
-    shows_environment: bool,
+    pub shows_environment: bool,
     /// Where the ray started (for the light's solid-angle density).
-    p: Vec3,
+    pub p: Vec3,
     /// Solid-angle density of the BSDF sample.
-    bsdf_pdf: f32,
+    pub bsdf_pdf: f32,
     /// The ray came from the camera or from a delta component: no light sample could
     /// have produced it, so its emission takes weight 1.
-    specular: bool,
+    pub specular: bool,
+}
+
+/// One camera path between two of its vertices: the ray to trace next and what the path
+/// has gathered so far.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct PathState {
+    pub ray: Ray,
+    /// Radiance found so far.
+    pub result: Rgb,
+    pub throughput: Rgb,
+    /// Product of the relative IORs crossed: Russian roulette divides the η² that
+    /// refraction puts into the throughput back out (Mitsuba 3's rule).
+    pub eta: f32,
+    pub prev: PreviousVertex,
+    /// Segments so far minus one: the vertex `ray` reaches ends segment depth + 1.
+    pub depth: u32,
+    /// Rays cast so far (closest hits and shadow rays).
+    pub rays: u64,
 }
 
 impl PathSample {
+    /// The longest path in segments (u32::MAX for unbounded).
+    pub(crate) fn max_depth(&self) -> u32 {
+        self.settings.max_depth.unwrap_or(u32::MAX)
+    }
+
+    /// The state of a path that starts with camera ray `ray`.
+    pub(crate) fn start(&self, ray: &Ray) -> PathState {
+        PathState {
+            ray: *ray,
+            result: Rgb::BLACK,
+            throughput: Rgb::WHITE,
+            eta: 1.0,
+            prev: PreviousVertex {
+                shows_emitters: !self.settings.hide_emitters,
+                shows_environment: !self.settings.hide_emitters,
+                p: ray.o,
+                bsdf_pdf: 1.0,
+                specular: true,
+            },
+            depth: 0,
+            rays: 0,
+        }
+    }
+
     /// Weight of emission from light `light` at `point`, reached by the BSDF-sampled ray
     /// from `prev`.
     fn emission_weight(
@@ -135,7 +188,7 @@ impl PathSample {
         frame: &Frame,
         bsdf: &Bsdf,
         wo: Vec3,
-        sampler: &mut CameraSampler,
+        sampler: &mut impl Sampler,
     ) -> (Rgb, u64) {
         let u_light = sampler.next_1d();
         let u = sampler.next_2d();
@@ -167,106 +220,135 @@ impl PathSample {
         };
         (f * ls.radiance * (weight / pdf_light), 1)
     }
+
+    /// The path's ray has been traced: `hit` is its closest hit, if any. Adds the emission
+    /// found there (the environment for a ray that escaped, an emitting surface's radiance
+    /// otherwise); false when the path ends here (it escaped, or reached `max_depth`).
+    pub(crate) fn arrive(
+        &self,
+        scene: &Scene,
+        state: &mut PathState,
+        hit: Option<&SurfaceInteraction>,
+    ) -> bool {
+        let prev = &state.prev;
+        let Some(si) = hit else {
+            if prev.shows_environment {
+                // The ray escaped: lights at infinity.
+                let towards_light = state.ray.d.normalize();
+                let point = LightPoint::direction(towards_light);
+                for &light in scene.lights.environment() {
+                    let le = scene.lights.get(light).le(&point, -towards_light);
+                    let w = self.emission_weight(scene, prev, light, &point);
+                    state.result += state.throughput * le * w;
+                }
+            }
+            return false;
+        };
+        // Emission from the surface hit (a path of depth + 1 segments).
+        if let Some(light) = scene.lights.light_of_shape(si.shape as usize)
+            && prev.shows_emitters
+        {
+            let point = LightPoint::from(si);
+            let le = scene.lights.get(light).le(&point, -state.ray.d.normalize());
+            if !le.is_black() {
+                let w = self.emission_weight(scene, prev, light, &point);
+                state.result += state.throughput * le * w;
+            }
+        }
+        state.depth + 1 < self.max_depth()
+    }
+
+    /// Scatters the path at `si`, the closest hit of its ray: next-event estimation (a path
+    /// of depth + 2 segments), the BSDF-sampled next ray and Russian roulette. False when
+    /// the path ends here.
+    pub(crate) fn scatter(
+        &self,
+        scene: &Scene,
+        state: &mut PathState,
+        si: &SurfaceInteraction,
+        sampler: &mut impl Sampler,
+    ) -> bool {
+        let bsdf = &*scene.bsdf_at(si);
+        let frame = si.frame();
+        let wo = frame.to_local(-state.ray.d.normalize());
+
+        // Next-event estimation.
+        if bsdf.has_non_delta() {
+            let (contribution, shadow_rays) =
+                self.sample_light(scene, si, &frame, bsdf, wo, sampler);
+            state.result += state.throughput * contribution;
+            state.rays += shadow_rays;
+        }
+
+        // BSDF sampling: the next segment.
+        let u_lobe = sampler.next_1d();
+        let u = sampler.next_2d();
+        let Some(bs) = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance) else {
+            return false;
+        };
+        state.throughput *= bs.weight;
+        state.eta *= bs.eta;
+        state.prev = PreviousVertex {
+            shows_emitters: true,
+            shows_environment: state.prev.shows_environment || !bsdf.is_null(),
+            p: si.p,
+            bsdf_pdf: bs.pdf,
+            specular: bs.delta,
+        };
+        state.ray = si.spawn_ray(frame.to_world(bs.wi));
+        state.depth += 1;
+
+        // Russian roulette.
+        let max_throughput = state.throughput.max_component();
+        if max_throughput <= 0.0 {
+            return false;
+        }
+        if state.depth >= self.settings.rr_depth {
+            let q = (max_throughput * state.eta * state.eta).min(0.95);
+            if sampler.next_1d() >= q {
+                return false;
+            }
+            state.throughput /= q;
+        }
+        true
+    }
 }
 
 impl CameraSampleFn for PathSample {
     fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut CameraSampler) -> (Rgb, u64) {
-        let max_depth = self.settings.max_depth.unwrap_or(u32::MAX);
-        if max_depth == 0 {
+        if self.max_depth() == 0 {
             return (Rgb::BLACK, 0);
         }
-        let mut ray = *ray;
-        let mut result = Rgb::BLACK;
-        let mut throughput = Rgb::WHITE;
-        // Product of the relative IORs crossed: Russian roulette divides the η² that
-        // refraction puts into the throughput back out (Mitsuba 3's rule).
-        let mut eta = 1.0f32;
-        let mut prev = PreviousVertex {
-            shows_emitters: !self.settings.hide_emitters,
-            shows_environment: !self.settings.hide_emitters,
-            p: ray.o,
-            bsdf_pdf: 1.0,
-            specular: true,
-        };
-        let mut rays = 0u64;
-        // Segments so far minus one: the vertex `si` below is the end of segment depth + 1.
-        let mut depth = 0u32;
+        let mut state = self.start(ray);
         loop {
-            rays += 1;
-            let Some(si) = scene.geometry.intersect(&ray) else {
-                if !prev.shows_environment {
-                    break;
-                }
-                // The ray escaped: lights at infinity.
-                let towards_light = ray.d.normalize();
-                let point = LightPoint::direction(towards_light);
-                for &light in scene.lights.environment() {
-                    let le = scene.lights.get(light).le(&point, -towards_light);
-                    let w = self.emission_weight(scene, &prev, light, &point);
-                    result += throughput * le * w;
-                }
-                break;
-            };
-            let wo_world = -ray.d.normalize();
-
-            // Emission from the surface hit (a path of depth + 1 segments).
-            if let Some(light) = scene.lights.light_of_shape(si.shape as usize)
-                && prev.shows_emitters
-            {
-                let point = LightPoint::from(&si);
-                let le = scene.lights.get(light).le(&point, wo_world);
-                if !le.is_black() {
-                    let w = self.emission_weight(scene, &prev, light, &point);
-                    result += throughput * le * w;
-                }
-            }
-            if depth + 1 >= max_depth {
+            state.rays += 1;
+            let hit = scene.geometry.intersect(&state.ray);
+            if !self.arrive(scene, &mut state, hit.as_ref()) {
                 break;
             }
-
-            let bsdf = &*scene.bsdf_at(&si);
-            let frame = si.frame();
-            let wo = frame.to_local(wo_world);
-
-            // Next-event estimation (a path of depth + 2 segments).
-            if bsdf.has_non_delta() {
-                let (contribution, shadow_rays) =
-                    self.sample_light(scene, &si, &frame, bsdf, wo, sampler);
-                result += throughput * contribution;
-                rays += shadow_rays;
-            }
-
-            // BSDF sampling: the next segment.
-            let u_lobe = sampler.next_1d();
-            let u = sampler.next_2d();
-            let Some(bs) = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance) else {
+            if !self.scatter(scene, &mut state, hit.as_ref().unwrap(), sampler) {
                 break;
-            };
-            throughput *= bs.weight;
-            eta *= bs.eta;
-            prev = PreviousVertex {
-                shows_emitters: true,
-                shows_environment: prev.shows_environment || !bsdf.is_null(),
-                p: si.p,
-                bsdf_pdf: bs.pdf,
-                specular: bs.delta,
-            };
-            ray = si.spawn_ray(frame.to_world(bs.wi));
-            depth += 1;
-
-            // Russian roulette.
-            let max_throughput = throughput.max_component();
-            if max_throughput <= 0.0 {
-                break;
-            }
-            if depth >= self.settings.rr_depth {
-                let q = (max_throughput * eta * eta).min(0.95);
-                if sampler.next_1d() >= q {
-                    break;
-                }
-                throughput /= q;
             }
         }
-        (result, rays)
+        (state.result, state.rays)
+    }
+
+    fn tiles_per_task(&self) -> usize {
+        if self.settings.wavefront {
+            wavefront::TILES_PER_TASK
+        } else {
+            1
+        }
+    }
+
+    fn render_tiles(&self, pass: &PassContext, rects: &[PixelRect]) -> Vec<(FilmTile, PassCounts)> {
+        if self.settings.wavefront {
+            self.render_tiles_in_lanes(pass, rects)
+        } else {
+            rects
+                .iter()
+                .map(|&rect| render_tile(pass, rect, self))
+                .collect()
+        }
     }
 }

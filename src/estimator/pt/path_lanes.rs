@@ -1,0 +1,142 @@
+//! Sixteen camera paths side by side: `PathState` with each field as sixteen lanes, so the
+//! wavefront (`wavefront.rs`) can advance all paths with lane arithmetic, and move any one
+//! of them out to the scalar code and back (`get` / `put`).
+
+use glam::Vec3;
+
+use super::{PathState, PreviousVertex};
+use crate::geometry::Ray;
+use crate::math::Rgb;
+use crate::math::lanes::{F32x16, LANES, Mask16, U32x16, V3};
+use crate::sampler::lane_streams::LaneStreams;
+
+/// Lane `i` of `v`.
+#[inline(always)]
+pub(super) fn lane(v: F32x16, i: usize) -> f32 {
+    v.to_array()[i]
+}
+
+/// `v` with lane `i` replaced by `x`.
+#[inline(always)]
+pub(super) fn with_lane(v: F32x16, i: usize, x: f32) -> F32x16 {
+    F32x16::select(Mask16(1 << i), F32x16::splat(x), v)
+}
+
+/// Lane `i` of a lane vector as a `Vec3`.
+#[inline(always)]
+pub(super) fn lane3(v: &V3<F32x16>, i: usize) -> Vec3 {
+    Vec3::new(lane(v.x, i), lane(v.y, i), lane(v.z, i))
+}
+
+/// Replaces lane `i` of `v` by `x`.
+#[inline(always)]
+pub(super) fn put3(v: &mut V3<F32x16>, i: usize, x: Vec3) {
+    v.x = with_lane(v.x, i, x.x);
+    v.y = with_lane(v.y, i, x.y);
+    v.z = with_lane(v.z, i, x.z);
+}
+
+/// Sixteen `PathState`s (one per lane), the random stream each draws from, and which
+/// camera sample each lane is tracing.
+pub(super) struct PathLanes {
+    /// Lanes that hold a path in progress.
+    pub live: Mask16,
+    /// Per lane: the index of its camera sample in the batch's queue.
+    pub sample: [u32; LANES],
+    pub origin: V3<F32x16>,
+    pub direction: V3<F32x16>,
+    pub t_max: F32x16,
+    /// Radiance found so far (r, g, b).
+    pub result: V3<F32x16>,
+    /// Throughput (r, g, b).
+    pub throughput: V3<F32x16>,
+    pub eta: F32x16,
+    pub prev_p: V3<F32x16>,
+    pub prev_pdf: F32x16,
+    pub prev_specular: Mask16,
+    pub shows_emitters: Mask16,
+    pub shows_environment: Mask16,
+    pub depth: U32x16,
+    pub rays: U32x16,
+    pub streams: LaneStreams,
+}
+
+impl Default for PathLanes {
+    fn default() -> Self {
+        let zero = F32x16::splat(0.0);
+        let zero3 = V3 {
+            x: zero,
+            y: zero,
+            z: zero,
+        };
+        PathLanes {
+            live: Mask16::NONE,
+            sample: [0; LANES],
+            origin: zero3,
+            direction: zero3,
+            t_max: zero,
+            result: zero3,
+            throughput: zero3,
+            eta: zero,
+            prev_p: zero3,
+            prev_pdf: zero,
+            prev_specular: Mask16::NONE,
+            shows_emitters: Mask16::NONE,
+            shows_environment: Mask16::NONE,
+            depth: U32x16::splat(0),
+            rays: U32x16::splat(0),
+            streams: LaneStreams::default(),
+        }
+    }
+}
+
+impl PathLanes {
+    /// The path in lane `i`.
+    pub fn get(&self, i: usize) -> PathState {
+        let rgb = |v: &V3<F32x16>| {
+            let c = lane3(v, i);
+            Rgb::new(c.x, c.y, c.z)
+        };
+        PathState {
+            ray: Ray {
+                o: lane3(&self.origin, i),
+                d: lane3(&self.direction, i),
+                t_max: lane(self.t_max, i),
+            },
+            result: rgb(&self.result),
+            throughput: rgb(&self.throughput),
+            eta: lane(self.eta, i),
+            prev: PreviousVertex {
+                shows_emitters: self.shows_emitters.get(i),
+                shows_environment: self.shows_environment.get(i),
+                p: lane3(&self.prev_p, i),
+                bsdf_pdf: lane(self.prev_pdf, i),
+                specular: self.prev_specular.get(i),
+            },
+            depth: self.depth.to_array()[i],
+            rays: self.rays.to_array()[i] as u64,
+        }
+    }
+
+    /// Lane `i` holds path `state` from now on.
+    pub fn put(&mut self, i: usize, state: &PathState) {
+        let rgb = |c: Rgb| Vec3::new(c.r(), c.g(), c.b());
+        put3(&mut self.origin, i, state.ray.o);
+        put3(&mut self.direction, i, state.ray.d);
+        self.t_max = with_lane(self.t_max, i, state.ray.t_max);
+        put3(&mut self.result, i, rgb(state.result));
+        put3(&mut self.throughput, i, rgb(state.throughput));
+        self.eta = with_lane(self.eta, i, state.eta);
+        self.shows_emitters.set(i, state.prev.shows_emitters);
+        self.shows_environment.set(i, state.prev.shows_environment);
+        put3(&mut self.prev_p, i, state.prev.p);
+        self.prev_pdf = with_lane(self.prev_pdf, i, state.prev.bsdf_pdf);
+        self.prev_specular.set(i, state.prev.specular);
+        let m = Mask16(1 << i);
+        self.depth = U32x16::select(m, U32x16::splat(state.depth), self.depth);
+        // A camera path casts at most a few thousand rays (max_depth bounds it, Russian
+        // roulette ends unbounded ones): u32 holds any count a path reaches.
+        let rays = state.rays.min(u32::MAX as u64) as u32;
+        self.rays = U32x16::select(m, U32x16::splat(rays), self.rays);
+    }
+}

@@ -1,0 +1,122 @@
+//! `pt` sixteen paths at a time: a wavefront in SIMD lanes.
+//!
+//! A task takes a batch of consecutive tiles and queues their camera samples. Sixteen
+//! lanes each trace one path; every round advances all of them by one vertex (closest
+//! hit, emission, scattering), and a lane whose path has ended takes the next sample from
+//! the queue, so the lanes stay full until the queue runs dry.
+//!
+//! Each path draws its random numbers from its own stream (a lane of `LaneStreams`,
+//! continuing the camera sample's `CameraSampler`), performs the scalar path tracer's
+//! operations in the same order, and its result is added to its tile in the queue's order.
+//! So the image is the scalar `pt`'s, bit for bit (`tests/pt.rs` checks it on every
+//! built-in scene); the wavefront changes only the speed. What the lane code does not
+//! cover is done by the scalar code for that lane (`PathSample::arrive` / `scatter`).
+
+use glam::Vec2;
+
+use super::PathSample;
+use super::path_lanes::PathLanes;
+use crate::estimator::camera_pass::{PassContext, PassCounts, start_camera_sample};
+use crate::film::{FilmTile, PixelRect};
+use crate::math::Rgb;
+use crate::math::lanes::LANES;
+use crate::sampler::IndependentSampler;
+
+/// Tiles of 16×16 pixels per task: 1024 paths keep the lanes full for most of a batch.
+pub(super) const TILES_PER_TASK: usize = 4;
+
+/// One camera sample of a batch: where it is and, once traced, what it found.
+#[derive(Clone, Copy)]
+struct QueuedSample {
+    pixel: (u32, u32),
+    raster: Vec2,
+    value: Rgb,
+    rays: u64,
+}
+
+impl PathSample {
+    /// `CameraSampleFn::render_tiles` for `pt`: the same tiles, traced in lanes.
+    pub(super) fn render_tiles_in_lanes(
+        &self,
+        pass: &PassContext,
+        rects: &[PixelRect],
+    ) -> Vec<(FilmTile, PassCounts)> {
+        let mut queue: Vec<QueuedSample> = rects
+            .iter()
+            .flat_map(|r| (r.y0..r.y1).flat_map(move |y| (r.x0..r.x1).map(move |x| (x, y))))
+            .map(|pixel| QueuedSample {
+                pixel,
+                raster: Vec2::ZERO,
+                value: Rgb::BLACK,
+                rays: 0,
+            })
+            .collect();
+        let mut lanes = PathLanes::default();
+        let mut next = 0usize;
+        let mut sampler = pass.camera_sampler();
+        loop {
+            // Empty lanes take the next camera samples.
+            for lane in (!lanes.live).lanes() {
+                while next < queue.len() && !lanes.live.get(lane) {
+                    let q = &mut queue[next];
+                    let (x, y) = q.pixel;
+                    let (raster, ray) = start_camera_sample(
+                        &pass.scene.camera,
+                        &mut sampler,
+                        x,
+                        y,
+                        pass.pass_index,
+                    );
+                    q.raster = raster;
+                    if self.max_depth() > 0 {
+                        lanes.put(lane, &self.start(&ray));
+                        lanes.streams.set_lane(lane, sampler.stream_state());
+                        lanes.sample[lane] = next as u32;
+                        lanes.live.set(lane, true);
+                    }
+                    next += 1;
+                }
+            }
+            if lanes.live.none() {
+                break;
+            }
+            self.advance_lanes(pass, &mut lanes, &mut queue);
+        }
+        // Finished samples go to their tiles in queue order, as `render_tile` adds them.
+        let mut samples = queue.iter();
+        rects
+            .iter()
+            .map(|&rect| {
+                let mut tile = pass.film.tile(rect);
+                let mut counts = PassCounts::default();
+                let n = ((rect.x1 - rect.x0) * (rect.y1 - rect.y0)) as usize;
+                for q in samples.by_ref().take(n) {
+                    counts.add_sample(&mut tile, q.raster, q.value, q.rays);
+                }
+                (tile, counts)
+            })
+            .collect()
+    }
+
+    /// Advances every live lane by one vertex; lanes whose path ends write it to `queue`.
+    fn advance_lanes(&self, pass: &PassContext, lanes: &mut PathLanes, queue: &mut [QueuedSample]) {
+        let scene = pass.scene;
+        for lane in lanes.live.lanes() {
+            let mut state = lanes.get(lane);
+            let mut sampler = IndependentSampler::with_state(0, lanes.streams.lane(lane));
+            state.rays += 1;
+            let hit = scene.geometry.intersect(&state.ray);
+            let going = self.arrive(scene, &mut state, hit.as_ref())
+                && self.scatter(scene, &mut state, hit.as_ref().unwrap(), &mut sampler);
+            lanes.put(lane, &state);
+            lanes.streams.set_lane(lane, sampler.state());
+            if !going {
+                let q = &mut queue[lanes.sample[lane] as usize];
+                q.value = state.result;
+                q.rays = state.rays;
+                lanes.live.set(lane, false);
+            }
+        }
+        debug_assert!(lanes.live.count() as usize <= LANES);
+    }
+}
