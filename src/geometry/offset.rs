@@ -11,6 +11,8 @@
 
 use glam::Vec3;
 
+use crate::math::lanes::{Real, V3};
+
 /// Unit roundoff of f32 round-to-nearest: |fl(x) − x| ≤ u·|x|.
 pub const UNIT_ROUNDOFF: f32 = f32::EPSILON * 0.5;
 
@@ -54,36 +56,23 @@ pub fn next_float_down(v: f32) -> f32 {
 /// away from `p`, in the direction of the offset, which cannot bring it back.
 #[inline]
 pub fn offset_ray_origin(p: Vec3, p_error: Vec3, ng: Vec3, w: Vec3) -> Vec3 {
-    let delta = ng.abs().dot(p_error);
-    let side = if w.dot(ng) < 0.0 { -delta } else { delta };
-    let offset = ng * side;
-    let po = p + offset;
-    // Branch-free (the sides are random): each coordinate moves one float towards the
-    // sign of its offset, none where the offset is zero.
-    Vec3::new(
-        step_towards(po.x, offset.x),
-        step_towards(po.y, offset.y),
-        step_towards(po.z, offset.z),
-    )
+    offset_origin(V3::from(p), V3::from(p_error), V3::from(ng), V3::from(w)).into()
 }
 
-/// `next_float_up(v)` for `dir` > 0, `next_float_down(v)` for `dir` < 0, `v` for `dir` = 0
-/// (and for non-finite `v`), without branches.
+/// `offset_ray_origin` over `Real` (one origin, or sixteen in lanes).
 #[inline(always)]
-fn step_towards(v: f32, dir: f32) -> f32 {
-    // next_float_down(v) = −next_float_up(−v): step |v| up or down in the direction of dir
-    // with the sign folded in. u = v·sign(dir) (as bits, no rounding); −0 counts as +0.
-    let flip = if dir < 0.0 { 0x8000_0000u32 } else { 0 };
-    let u = f32::from_bits(v.to_bits() ^ flip);
-    let u = if u == 0.0 { 0.0 } else { u };
-    let bits = u.to_bits();
-    let up = if u >= 0.0 { bits + 1 } else { bits - 1 };
-    let stepped = f32::from_bits(up ^ flip);
-    if dir == 0.0 || !v.is_finite() {
-        v
-    } else {
-        stepped
-    }
+pub fn offset_origin<T: Real>(p: V3<T>, p_error: V3<T>, ng: V3<T>, w: V3<T>) -> V3<T> {
+    let delta = ng.abs().dot(p_error);
+    let side = T::select(w.dot(ng).lt(T::splat(0.0)), -delta, delta);
+    let offset = ng * side;
+    let po = p + offset;
+    // Each coordinate moves one float towards the sign of its offset, none where the
+    // offset is zero.
+    V3::new(
+        po.x.step_towards(offset.x),
+        po.y.step_towards(offset.y),
+        po.z.step_towards(offset.z),
+    )
 }
 
 #[cfg(test)]
@@ -139,16 +128,16 @@ mod tests {
             f32::MAX,
         ] {
             assert_eq!(
-                step_towards(v, 1.0).to_bits(),
+                v.step_towards(1.0).to_bits(),
                 next_float_up(v).to_bits(),
                 "{v}"
             );
             assert_eq!(
-                step_towards(v, -0.5).to_bits(),
+                v.step_towards(-0.5).to_bits(),
                 next_float_down(v).to_bits(),
                 "{v}"
             );
-            assert_eq!(step_towards(v, 0.0).to_bits(), v.to_bits(), "{v}");
+            assert_eq!(v.step_towards(0.0).to_bits(), v.to_bits(), "{v}");
         }
     }
 }

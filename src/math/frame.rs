@@ -2,6 +2,8 @@
 
 use glam::Vec3;
 
+use crate::math::lanes::{Real, V3};
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Frame {
     pub s: Vec3,
@@ -12,20 +14,55 @@ pub struct Frame {
 impl Frame {
     /// A frame around a unit normal, built without branches on the normal's direction
     /// (Duff et al. 2017, "Building an Orthonormal Basis, Revisited").
+    #[inline]
     pub fn from_normal(n: Vec3) -> Self {
-        let sign = 1.0f32.copysign(n.z);
-        let a = -1.0 / (sign + n.z);
-        let b = n.x * n.y * a;
-        let s = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-        let t = Vec3::new(b, sign + n.y * n.y * a, -n.y);
-        Frame { s, t, n }
+        let f = LaneFrame::from_normal(V3::from(n));
+        Frame {
+            s: f.s.into(),
+            t: f.t.into(),
+            n,
+        }
     }
 
+    #[inline]
     pub fn to_local(&self, v: Vec3) -> Vec3 {
         Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
     }
 
+    #[inline]
     pub fn to_world(&self, v: Vec3) -> Vec3 {
+        self.s * v.x + self.t * v.y + self.n * v.z
+    }
+}
+
+/// `Frame` over `Real`: one frame, or sixteen in lanes, with the same arithmetic.
+#[derive(Clone, Copy, Debug)]
+pub struct LaneFrame<T> {
+    pub s: V3<T>,
+    pub t: V3<T>,
+    pub n: V3<T>,
+}
+
+impl<T: Real> LaneFrame<T> {
+    /// As `Frame::from_normal` (Duff et al. 2017).
+    #[inline(always)]
+    pub fn from_normal(n: V3<T>) -> Self {
+        let one = T::splat(1.0);
+        let sign = one.copysign(n.z);
+        let a = T::splat(-1.0) / (sign + n.z);
+        let b = n.x * n.y * a;
+        let s = V3::new(one + sign * n.x * n.x * a, sign * b, -sign * n.x);
+        let t = V3::new(b, sign + n.y * n.y * a, -n.y);
+        LaneFrame { s, t, n }
+    }
+
+    #[inline(always)]
+    pub fn to_local(&self, v: V3<T>) -> V3<T> {
+        V3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+    }
+
+    #[inline(always)]
+    pub fn to_world(&self, v: V3<T>) -> V3<T> {
         self.s * v.x + self.t * v.y + self.n * v.z
     }
 }

@@ -6,6 +6,7 @@
 
 use glam::{Vec2, Vec3};
 
+use crate::math::lanes::{Real, V3};
 use crate::math::{INV_PI, PI};
 
 /// Uniform point on a triangle as barycentrics (b1, b2) (Shirley & Chiu 1997 square-root map).
@@ -29,32 +30,42 @@ pub fn sphere_pdf() -> f32 {
 
 /// Uniform point on the unit disk by Shirley & Chiu's (1997) concentric map, which keeps
 /// neighbourhoods compact (low distortion); density 1/π.
+#[inline]
 pub fn square_to_disk_concentric(u: Vec2) -> Vec2 {
-    let a = 2.0 * u.x - 1.0;
-    let b = 2.0 * u.y - 1.0;
-    if a == 0.0 && b == 0.0 {
-        return Vec2::ZERO;
-    }
+    let (x, y) = disk_concentric(u.x, u.y);
+    Vec2::new(x, y)
+}
+
+/// `square_to_disk_concentric` over `Real` (one point, or sixteen in lanes).
+#[inline(always)]
+pub fn disk_concentric<T: Real>(ux: T, uy: T) -> (T, T) {
+    let (one, two, zero) = (T::splat(1.0), T::splat(2.0), T::splat(0.0));
+    let a = two * ux - one;
+    let b = two * uy - one;
     // φ = θ in the wedges around the x axis and φ = π/2 − θ in those around the y axis, with
     // θ = (π/4)·(ratio of the two coordinates) in [−π/4, π/4] either way.
-    if a * a > b * b {
-        let (sin, cos) = sin_cos_quarter((PI / 4.0) * (b / a));
-        Vec2::new(a * cos, a * sin)
-    } else {
-        let (sin, cos) = sin_cos_quarter((PI / 4.0) * (a / b));
-        Vec2::new(b * sin, b * cos)
-    }
+    let around_x = (a * a).gt(b * b);
+    let (num, den) = (T::select(around_x, b, a), T::select(around_x, a, b));
+    let (sin, cos) = sin_cos_quarter(T::splat(PI / 4.0) * (num / den));
+    let r = T::select(around_x, a, b);
+    let x = r * T::select(around_x, cos, sin);
+    let y = r * T::select(around_x, sin, cos);
+    let centre = a.eq(zero) & b.eq(zero);
+    (T::select(centre, zero, x), T::select(centre, zero, y))
 }
 
 /// (sin θ, cos θ) for θ in [−π/4, π/4], by polynomials fitted (least squares, in mltbench)
 /// to sin θ / θ and cos θ on that interval: both within 1e-7 of the exact values in f32,
 /// inline and without the range reduction of the general functions.
-#[inline]
-fn sin_cos_quarter(theta: f32) -> (f32, f32) {
+#[inline(always)]
+fn sin_cos_quarter<T: Real>(theta: T) -> (T, T) {
+    let c = T::splat;
     let t2 = theta * theta;
-    let sin = theta * (1.0 + t2 * (-0.166_666_57 + t2 * (0.008_332_327 + t2 * -0.000_195_374_87)));
-    let cos =
-        1.0 + t2 * (-0.5 + t2 * (0.041_666_63 + t2 * (-0.001_388_697_9 + t2 * 0.000_024_410_747)));
+    let sin = theta
+        * (c(1.0) + t2 * (c(-0.166_666_57) + t2 * (c(0.008_332_327) + t2 * c(-0.000_195_374_87))));
+    let cos = c(1.0)
+        + t2 * (c(-0.5)
+            + t2 * (c(0.041_666_63) + t2 * (c(-0.001_388_697_9) + t2 * c(0.000_024_410_747))));
     (sin, cos)
 }
 
@@ -69,10 +80,20 @@ pub fn disk_pdf(p: Vec2) -> f32 {
 
 /// Cosine-weighted direction on the upper hemisphere (z ≥ 0) by Malley's method: a uniform
 /// point on the disk lifted onto the hemisphere; pdf cos θ / π.
+#[inline]
 pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let p = square_to_disk_concentric(u);
-    let z = (1.0 - p.length_squared()).max(0.0).sqrt();
-    Vec3::new(p.x, p.y, z)
+    cosine_hemisphere(u.x, u.y).into()
+}
+
+/// `square_to_cosine_hemisphere` over `Real` (one direction, or sixteen in lanes).
+#[inline(always)]
+pub fn cosine_hemisphere<T: Real>(ux: T, uy: T) -> V3<T> {
+    let (x, y) = disk_concentric(ux, uy);
+    // max(1 − r², 0), NaN to 0, as `f32::max` gives it.
+    let z = (T::splat(1.0) - (x * x + y * y))
+        .max_gt(T::splat(0.0))
+        .sqrt();
+    V3::new(x, y, z)
 }
 
 /// Solid-angle density of `square_to_cosine_hemisphere`: cos θ / π above the surface, 0 below.

@@ -76,6 +76,13 @@ impl Scene {
         }
     }
 
+    /// The BSDF of shape `shape` wherever it has no texture: None for a textured one
+    /// (`bsdf_at` looks its textures up per hit).
+    pub fn untextured_bsdf(&self, shape: usize) -> Option<&Bsdf> {
+        let index = self.description.shapes[shape].bsdf;
+        (!self.textured[index]).then(|| &self.bsdfs[index])
+    }
+
     /// Width of the rendered image: the film's crop window, if it has one.
     pub fn width(&self) -> u32 {
         self.description.sensor.film.window().width

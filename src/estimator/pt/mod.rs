@@ -22,6 +22,9 @@
 use glam::Vec3;
 
 use super::Params;
+mod diffuse_lanes;
+mod hit_lanes;
+mod lane_scene;
 mod path_lanes;
 mod wavefront;
 
@@ -93,12 +96,25 @@ pub type PathTracer = CameraEstimator<PathSample>;
 
 /// Makes `pt` for `scene` with `settings`; an error when its film does not fit in memory.
 pub fn new(scene: &Scene, seed: u64, settings: PtSettings) -> Result<PathTracer> {
-    CameraEstimator::new("pt", scene, seed, PathSample { settings })
+    let lane_scene = settings
+        .wavefront
+        .then(|| lane_scene::LaneScene::new(scene));
+    CameraEstimator::new(
+        "pt",
+        scene,
+        seed,
+        PathSample {
+            settings,
+            lane_scene,
+        },
+    )
 }
 
 /// Traces one camera path.
 pub struct PathSample {
     settings: PtSettings,
+    /// The scene's tables for the wavefront (with `settings.wavefront`).
+    lane_scene: Option<lane_scene::LaneScene>,
 }
 
 /// What the next vertex needs to weight emission found by the BSDF-sampled ray.

@@ -15,11 +15,13 @@
 use glam::Vec2;
 
 use super::PathSample;
+use super::hit_lanes::HitLanes;
+use super::lane_scene::NO_LIGHT;
 use super::path_lanes::PathLanes;
 use crate::estimator::camera_pass::{PassContext, PassCounts, start_camera_sample};
 use crate::film::{FilmTile, PixelRect};
 use crate::math::Rgb;
-use crate::math::lanes::LANES;
+use crate::math::lanes::{Mask16, U32x16};
 use crate::sampler::IndependentSampler;
 
 /// Tiles of 16×16 pixels per task: 1024 paths keep the lanes full for most of a batch.
@@ -101,22 +103,57 @@ impl PathSample {
     /// Advances every live lane by one vertex; lanes whose path ends write it to `queue`.
     fn advance_lanes(&self, pass: &PassContext, lanes: &mut PathLanes, queue: &mut [QueuedSample]) {
         let scene = pass.scene;
-        for lane in lanes.live.lanes() {
+        let tables = self
+            .lane_scene
+            .as_ref()
+            .expect("pt built its lane tables with the wavefront on");
+        let live = lanes.live;
+        let one = U32x16::splat(1);
+        let zero = U32x16::splat(0);
+
+        // The closest hits.
+        let hits = HitLanes::trace(scene, lanes);
+        lanes.rays = lanes.rays + U32x16::select(live, one, zero);
+
+        // Arriving (`arrive`): escaped rays and emitters seen by the scalar code; the other
+        // lanes only check the depth.
+        let light = U32x16::gather(&tables.light, hits.shape, hits.hit);
+        let emitter = hits.hit & !light.eq(U32x16::splat(NO_LIGHT)) & lanes.shows_emitters;
+        let mut ended = Mask16::NONE;
+        for lane in ((live & !hits.hit) | emitter).lanes() {
+            let mut state = lanes.get(lane);
+            if !self.arrive(scene, &mut state, hits.interaction(lane)) {
+                ended.set(lane, true);
+            }
+            lanes.put(lane, &state);
+        }
+        let deep = !(lanes.depth + one).lt(U32x16::splat(self.max_depth()));
+        ended |= hits.hit & !emitter & deep;
+
+        // Scattering: diffuse surfaces in lanes, the others one by one.
+        let going = live & !ended;
+        let diffuse = going & U32x16::gather(&tables.diffuse, hits.shape, going).eq(one);
+        ended |= self.scatter_diffuse(scene, tables, lanes, &hits, diffuse);
+        for lane in (going & !diffuse).lanes() {
             let mut state = lanes.get(lane);
             let mut sampler = IndependentSampler::with_state(0, lanes.streams.lane(lane));
-            state.rays += 1;
-            let hit = scene.geometry.intersect(&state.ray);
-            let going = self.arrive(scene, &mut state, hit.as_ref())
-                && self.scatter(scene, &mut state, hit.as_ref().unwrap(), &mut sampler);
+            let si = hits
+                .interaction(lane)
+                .expect("a lane that scatters has a hit");
+            if !self.scatter(scene, &mut state, si, &mut sampler) {
+                ended.set(lane, true);
+            }
             lanes.put(lane, &state);
             lanes.streams.set_lane(lane, sampler.state());
-            if !going {
-                let q = &mut queue[lanes.sample[lane] as usize];
-                q.value = state.result;
-                q.rays = state.rays;
-                lanes.live.set(lane, false);
-            }
         }
-        debug_assert!(lanes.live.count() as usize <= LANES);
+
+        // Finished paths go to the queue.
+        for lane in ended.lanes() {
+            let state = lanes.get(lane);
+            let q = &mut queue[lanes.sample[lane] as usize];
+            q.value = state.result;
+            q.rays = state.rays;
+        }
+        lanes.live = live & !ended;
     }
 }

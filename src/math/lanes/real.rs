@@ -46,6 +46,10 @@ pub trait Real:
     fn max_gt(self, o: Self) -> Self;
     /// `if self < o { self } else { o }`.
     fn min_lt(self, o: Self) -> Self;
+    /// One float from `self` towards the sign of `dir` (the next float up for dir > 0,
+    /// down for dir < 0); `self` unchanged where `dir` is ±0 or `self` is not finite. −0
+    /// counts as +0, so both step to the same neighbour.
+    fn step_towards(self, dir: Self) -> Self;
 }
 
 impl Real for f32 {
@@ -107,11 +111,32 @@ impl Real for f32 {
     fn min_lt(self, o: f32) -> f32 {
         if self < o { self } else { o }
     }
+    #[inline(always)]
+    fn step_towards(self, dir: f32) -> f32 {
+        // next_float_down(v) = −next_float_up(−v): step |v| up or down in the direction of
+        // dir with the sign folded in. u = v·sign(dir) (as bits, no rounding); −0 counts as
+        // +0. Branch-free: offset directions are random.
+        let flip = if dir < 0.0 { 0x8000_0000u32 } else { 0 };
+        let u = f32::from_bits(self.to_bits() ^ flip);
+        let u = if u == 0.0 { 0.0 } else { u };
+        let bits = u.to_bits();
+        let up = if u >= 0.0 {
+            bits.wrapping_add(1)
+        } else {
+            bits.wrapping_sub(1)
+        };
+        let stepped = f32::from_bits(up ^ flip);
+        if dir == 0.0 || !self.is_finite() {
+            self
+        } else {
+            stepped
+        }
+    }
 }
 
 /// `Real` for a sixteen-lane type with the inherent methods of the lane backends.
 macro_rules! real_lanes {
-    ($ty:ty) => {
+    ($ty:ty, $u:ty) => {
         impl Real for $ty {
             type Mask = Mask16;
 
@@ -171,10 +196,23 @@ macro_rules! real_lanes {
             fn min_lt(self, o: Self) -> Self {
                 <$ty>::min_lt(self, o)
             }
+            #[inline(always)]
+            fn step_towards(self, dir: Self) -> Self {
+                // `f32::step_towards`, lane by lane in integer arithmetic.
+                let zero = <$ty>::splat(0.0);
+                let flip = <$u>::select(dir.lt(zero), <$u>::splat(0x8000_0000), <$u>::splat(0));
+                let u = <$ty>::from_bits(self.to_bits() ^ flip);
+                let u = <$ty>::select(u.eq(zero), zero, u);
+                let bits = u.to_bits();
+                let one = <$u>::splat(1);
+                let up = <$u>::select(u.ge(zero), bits + one, bits - one);
+                let stepped = <$ty>::from_bits(up ^ flip);
+                <$ty>::select(dir.eq(zero) | !self.is_finite(), self, stepped)
+            }
         }
     };
 }
 
-real_lanes!(portable::F32x16);
+real_lanes!(portable::F32x16, portable::U32x16);
 #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-real_lanes!(super::avx512::F32x16);
+real_lanes!(super::avx512::F32x16, super::avx512::U32x16);

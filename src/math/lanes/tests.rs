@@ -113,6 +113,11 @@ fn f32_operations_equal_scalar_ones<T: LaneArray>() {
         let lt = |p: f32, q: f32| if p < q { p } else { q };
         same_bits(x.max_gt(y).to_array(), |i| gt(a[i], b[i]), "max_gt");
         same_bits(x.min_lt(y).to_array(), |i| lt(a[i], b[i]), "min_lt");
+        same_bits(
+            x.step_towards(y).to_array(),
+            |i| a[i].step_towards(b[i]),
+            "step_towards",
+        );
         let masks = [
             (x.lt(y), (|p, q| p < q) as fn(f32, f32) -> bool, "lt"),
             (x.le(y), |p, q| p <= q, "le"),

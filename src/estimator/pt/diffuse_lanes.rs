@@ -1,0 +1,246 @@
+//! `PathSample::scatter` in lanes, for paths at an untextured `diffuse` surface: next-event
+//! estimation, cosine-weighted sampling of the next direction, Russian roulette. Every
+//! operation is the scalar code's, in its order (see `wavefront.rs`), with the scalar
+//! code's early returns turned into lane masks.
+
+use super::PathSample;
+use super::hit_lanes::HitLanes;
+use super::lane_scene::LaneScene;
+use super::path_lanes::{PathLanes, lane, lane3};
+use crate::geometry::offset::offset_origin;
+use crate::geometry::{Ray, SHADOW_EPSILON};
+use crate::math::INV_PI;
+use crate::math::frame::LaneFrame;
+use crate::math::lanes::{F32x16, LANES, Mask16, U32x16, V3};
+use crate::math::warp::cosine_hemisphere;
+use crate::path::mis::power_heuristic;
+use crate::scene::Scene;
+use glam::Vec2;
+
+/// What next-event estimation drew per lane (`Light::sample_li` and the light's choice).
+struct LightSampleLanes {
+    /// Lanes with a sample (a light was chosen and returned a point).
+    ok: Mask16,
+    p: V3<F32x16>,
+    n: V3<F32x16>,
+    p_error: V3<F32x16>,
+    wi: V3<F32x16>,
+    /// The point is at a finite distance (not a light at infinity).
+    finite: Mask16,
+    radiance: V3<F32x16>,
+    pdf_solid_angle: F32x16,
+    /// Probability of having chosen the light.
+    pmf: F32x16,
+    delta: Mask16,
+}
+
+impl LightSampleLanes {
+    /// Chooses a light and a point on it for every lane of `m`, one lane at a time.
+    fn sample(
+        scene: &Scene,
+        p: &V3<F32x16>,
+        u_light: F32x16,
+        u: (F32x16, F32x16),
+        m: Mask16,
+    ) -> LightSampleLanes {
+        let mut ok = Mask16::NONE;
+        let mut finite = Mask16::NONE;
+        let mut delta = Mask16::NONE;
+        let mut v = [[[0.0f32; 3]; LANES]; 5];
+        let (mut pdf, mut pmf_l) = ([0.0f32; LANES], [0.0f32; LANES]);
+        let (u_light, ux, uy) = (u_light.to_array(), u.0.to_array(), u.1.to_array());
+        for i in m.lanes() {
+            let Some((index, pmf, _)) = scene.lights.sample(u_light[i]) else {
+                continue;
+            };
+            let Some(ls) = scene
+                .lights
+                .get(index)
+                .sample_li(lane3(p, i), Vec2::new(ux[i], uy[i]))
+            else {
+                continue;
+            };
+            ok.set(i, true);
+            finite.set(i, ls.dist.is_finite());
+            delta.set(i, ls.delta);
+            let rad = ls.radiance;
+            for (k, x) in [
+                ls.p,
+                ls.n,
+                ls.p_error,
+                ls.wi,
+                glam::Vec3::new(rad.r(), rad.g(), rad.b()),
+            ]
+            .iter()
+            .enumerate()
+            {
+                v[k][i] = x.to_array();
+            }
+            pdf[i] = ls.pdf_solid_angle;
+            pmf_l[i] = pmf;
+        }
+        let to_lanes = |k: usize| {
+            V3::new(
+                F32x16::from_array(std::array::from_fn(|i| v[k][i][0])),
+                F32x16::from_array(std::array::from_fn(|i| v[k][i][1])),
+                F32x16::from_array(std::array::from_fn(|i| v[k][i][2])),
+            )
+        };
+        LightSampleLanes {
+            ok,
+            p: to_lanes(0),
+            n: to_lanes(1),
+            p_error: to_lanes(2),
+            wi: to_lanes(3),
+            finite,
+            radiance: to_lanes(4),
+            pdf_solid_angle: F32x16::from_array(pdf),
+            pmf: F32x16::from_array(pmf_l),
+            delta,
+        }
+    }
+}
+
+/// Rust's `f32::max` per lane (a NaN operand gives the other one).
+#[inline(always)]
+fn max_num(a: F32x16, b: F32x16) -> F32x16 {
+    F32x16::select(a.is_nan(), b, F32x16::select(b.is_nan(), a, a.max_gt(b)))
+}
+
+/// Rust's `f32::min` per lane (a NaN operand gives the other one).
+#[inline(always)]
+fn min_num(a: F32x16, b: F32x16) -> F32x16 {
+    F32x16::select(a.is_nan(), b, F32x16::select(b.is_nan(), a, a.min_lt(b)))
+}
+
+/// `power_heuristic(a, b)` per lane: the f32 formula in lanes, and the scalar function
+/// for the rare lanes where it overflows.
+#[inline(always)]
+fn power_heuristic_lanes(pdf_a: F32x16, pdf_b: F32x16, m: Mask16) -> F32x16 {
+    let a = pdf_a * pdf_a;
+    let b = pdf_b * pdf_b;
+    let sum = a + b;
+    let w = a / sum;
+    let fine = sum.is_finite() & w.is_finite();
+    let mut w = w;
+    for i in (m & !fine).lanes() {
+        let wi = power_heuristic(lane(pdf_a, i), lane(pdf_b, i));
+        w = F32x16::select(Mask16(1 << i), F32x16::splat(wi), w);
+    }
+    w
+}
+
+impl PathSample {
+    /// `scatter` for the lanes of `m` (live, at an untextured `diffuse` surface). Returns
+    /// the lanes whose path ends here.
+    pub(super) fn scatter_diffuse(
+        &self,
+        scene: &Scene,
+        tables: &LaneScene,
+        lanes: &mut PathLanes,
+        hits: &HitLanes,
+        m: Mask16,
+    ) -> Mask16 {
+        let zero = F32x16::splat(0.0);
+        let zero3 = V3::new(zero, zero, zero);
+        let rho = V3::new(
+            F32x16::gather(&tables.reflectance[0], hits.shape, m),
+            F32x16::gather(&tables.reflectance[1], hits.shape, m),
+            F32x16::gather(&tables.reflectance[2], hits.shape, m),
+        );
+        let frame = LaneFrame::from_normal(hits.ns);
+        let wo = frame.to_local(-lanes.direction.normalize());
+
+        // Next-event estimation (`sample_light`).
+        let u_light = lanes.streams.next_1d(m);
+        let u = lanes.streams.next_2d(m);
+        let ls = LightSampleLanes::sample(scene, &hits.p, u_light, u, m);
+        let wi = frame.to_local(ls.wi);
+        let inv_pi = F32x16::splat(INV_PI);
+        // Diffuse::eval: R/π where both directions are above the surface, black elsewhere.
+        let above = wo.z.gt(zero) & wi.z.gt(zero);
+        let f = V3::select(above, rho * inv_pi, zero3) * wi.z.abs();
+        let black = f.x.eq(zero) & f.y.eq(zero) & f.z.eq(zero);
+        let shoot = m & ls.ok & !black;
+        // The shadow ray: to the light's point, both ends offset off their surfaces, or
+        // towards a light at infinity.
+        let to_point = ls.finite;
+        let o_to_point = offset_origin(hits.p, hits.p_error, hits.ng, ls.p - hits.p);
+        let target = offset_origin(ls.p, ls.p_error, ls.n, o_to_point - ls.p);
+        let o_away = offset_origin(hits.p, hits.p_error, hits.ng, ls.wi);
+        let origin = V3::select(to_point, o_to_point, o_away);
+        let dir = V3::select(to_point, target - o_to_point, ls.wi);
+        let t_max = F32x16::select(
+            to_point,
+            F32x16::splat(1.0 - SHADOW_EPSILON),
+            F32x16::splat(f32::INFINITY),
+        );
+        let mut lit = Mask16::NONE;
+        for i in shoot.lanes() {
+            let ray = Ray {
+                o: lane3(&origin, i),
+                d: lane3(&dir, i),
+                t_max: lane(t_max, i),
+            };
+            lit.set(i, !scene.geometry.occluded(&ray));
+        }
+        lanes.rays = lanes.rays + U32x16::select(shoot, U32x16::splat(1), U32x16::splat(0));
+        let pdf_light = ls.pmf * ls.pdf_solid_angle;
+        // Diffuse::pdf: the cosine density where wo is above the surface.
+        let bsdf_pdf = F32x16::select(
+            wo.z.gt(zero),
+            F32x16::select(wi.z.gt(zero), wi.z * inv_pi, zero),
+            zero,
+        );
+        let weight = F32x16::select(
+            ls.delta,
+            F32x16::splat(1.0),
+            power_heuristic_lanes(pdf_light, bsdf_pdf, lit & !ls.delta),
+        );
+        let contribution = V3::select(lit, f.mul_v(ls.radiance) * (weight / pdf_light), zero3);
+        lanes.result = V3::select(
+            m,
+            lanes.result + lanes.throughput.mul_v(contribution),
+            lanes.result,
+        );
+
+        // BSDF sampling (`Diffuse::sample`): the next segment.
+        let _u_lobe = lanes.streams.next_1d(m);
+        let (ux, uy) = lanes.streams.next_2d(m);
+        let wi = cosine_hemisphere(ux, uy);
+        let pdf = F32x16::select(wi.z.gt(zero), wi.z * inv_pi, zero);
+        let sampled = m & !wo.z.le(zero) & !pdf.le(zero);
+        let mut ends = m & !sampled;
+        let c = sampled;
+        lanes.throughput = V3::select(c, lanes.throughput.mul_v(rho), lanes.throughput);
+        lanes.shows_emitters |= c;
+        lanes.shows_environment |= c;
+        lanes.prev_specular = lanes.prev_specular & !c;
+        lanes.prev_p = V3::select(c, hits.p, lanes.prev_p);
+        lanes.prev_pdf = F32x16::select(c, pdf, lanes.prev_pdf);
+        let d = frame.to_world(wi);
+        lanes.origin = V3::select(
+            c,
+            offset_origin(hits.p, hits.p_error, hits.ng, d),
+            lanes.origin,
+        );
+        lanes.direction = V3::select(c, d, lanes.direction);
+        lanes.t_max = F32x16::select(c, F32x16::splat(f32::INFINITY), lanes.t_max);
+        lanes.depth = lanes.depth + U32x16::select(c, U32x16::splat(1), U32x16::splat(0));
+
+        // Russian roulette.
+        let t = lanes.throughput;
+        let max_throughput = max_num(max_num(t.x, t.y), t.z);
+        let dark = c & max_throughput.le(zero);
+        ends |= dark;
+        let rr_depth = U32x16::splat(self.settings.rr_depth);
+        let roulette = c & !dark & !lanes.depth.lt(rr_depth);
+        let q = min_num(max_throughput * lanes.eta * lanes.eta, F32x16::splat(0.95));
+        let u = lanes.streams.next_1d(roulette);
+        let killed = roulette & u.ge(q);
+        ends |= killed;
+        let survived = roulette & !killed;
+        lanes.throughput = V3::select(survived, t.div_scalar(q), t);
+        ends
+    }
+}
