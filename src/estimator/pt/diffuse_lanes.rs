@@ -215,7 +215,7 @@ impl PathSample {
         lanes.throughput = V3::select(c, lanes.throughput.mul_v(rho), lanes.throughput);
         lanes.shows_emitters |= c;
         lanes.shows_environment |= c;
-        lanes.prev_specular = lanes.prev_specular & !c;
+        lanes.prev_specular &= !c;
         lanes.prev_p = V3::select(c, hits.p, lanes.prev_p);
         lanes.prev_pdf = F32x16::select(c, pdf, lanes.prev_pdf);
         let d = frame.to_world(wi);
