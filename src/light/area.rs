@@ -6,7 +6,8 @@
 use glam::{Vec2, Vec3};
 
 use crate::light::shape_sampling::ShapeSampler;
-use crate::light::{EmissionSample, LightPoint, LightSample};
+use crate::light::{EmissionSample, LightPoint, LightSample, LightSampleLanes};
+use crate::math::lanes::{F32x16, Mask16, V3};
 use crate::math::{Frame, INV_PI, PI, Rgb, warp};
 
 #[derive(Clone, Debug, PartialEq)]
@@ -67,6 +68,39 @@ impl AreaLight {
             pdf_solid_angle: s.pdf_solid_angle,
             pdf_area: s.pdf_area,
             delta: false,
+        })
+    }
+
+    /// `sample_li` for the lanes of `m` (reference points `r`), lane by lane the same bits;
+    /// None where the lanes cannot sample the shape (`ShapeSampler::sample_from_lanes`).
+    #[inline]
+    pub fn sample_li_lanes(
+        &self,
+        r: V3<F32x16>,
+        ux: F32x16,
+        uy: F32x16,
+        m: Mask16,
+    ) -> Option<LightSampleLanes> {
+        let s = self.shape.sample_from_lanes(r, ux, uy, m)?;
+        let d = s.point.p - r;
+        let dist = d.length();
+        let wi = d.div_scalar(dist);
+        // One-sided, as `sample_li` (false for NaN too).
+        let faces_r = s.point.n.dot(wi).lt(F32x16::splat(0.0));
+        let c = |v: f32| F32x16::splat(v);
+        Some(LightSampleLanes {
+            ok: s.ok & dist.gt(c(0.0)) & faces_r,
+            p: s.point.p,
+            n: s.point.n,
+            p_error: s.point.p_error,
+            wi,
+            radiance: V3::new(
+                c(self.radiance.r()),
+                c(self.radiance.g()),
+                c(self.radiance.b()),
+            ),
+            pdf_solid_angle: s.pdf_solid_angle,
+            pdf_area: s.pdf_area,
         })
     }
 

@@ -9,11 +9,17 @@
 
 use glam::Vec2;
 
+use crate::math::lanes::{F32x16, F64x8, Mask16, U32x16};
+
 /// The largest f32 below one: sampled positions stay in [0, 1).
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
 /// Up to this many items `find` counts instead of searching.
 const SMALL: usize = 16;
+
+/// The most items `sample_discrete_lanes` samples in lanes (a light's triangles, a scene's
+/// lights: one compare per item and lane).
+pub const LANE_ITEMS: usize = 16;
 
 /// A piecewise-constant density on [0, 1) with `n` equal intervals, proportional to the
 /// weights it was built from; equally the discrete distribution with probabilities
@@ -110,6 +116,73 @@ impl Distribution1D {
         };
         // The probability as `pmf` computes it, so MIS weights see identical values.
         (i, self.pmf(i), remapped.clamp(0.0, ONE_MINUS_EPSILON))
+    }
+
+    /// `sample_discrete` for the lanes of `m`, lane by lane the same bits (other lanes:
+    /// index 0, pmf and remapped 0). For at most `LANE_ITEMS` items; more are sampled one
+    /// lane at a time by `sample_discrete` itself.
+    #[inline]
+    pub fn sample_discrete_lanes(&self, u: F32x16, m: Mask16) -> (U32x16, F32x16, F32x16) {
+        let n = self.func.len();
+        if n > LANE_ITEMS {
+            let u = u.to_array();
+            let (mut index, mut pmf, mut remapped) = ([0u32; 16], [0.0f32; 16], [0.0f32; 16]);
+            for i in m.lanes() {
+                let (k, p, r) = self.sample_discrete(u[i]);
+                (index[i], pmf[i], remapped[i]) = (k as u32, p, r);
+            }
+            return (
+                U32x16::from_array(index),
+                F32x16::from_array(pmf),
+                F32x16::from_array(remapped),
+            );
+        }
+        let clamp = |v: F32x16| {
+            let v = F32x16::select(v.lt(F32x16::splat(0.0)), F32x16::splat(0.0), v);
+            F32x16::select(
+                v.gt(F32x16::splat(ONE_MINUS_EPSILON)),
+                F32x16::splat(ONE_MINUS_EPSILON),
+                v,
+            )
+        };
+        let (u_lo, u_hi) = clamp(u).to_f64_halves();
+        // `find`: the number of cdf entries <= u, minus one, at most n − 1.
+        let one = U32x16::splat(1);
+        let mut count = U32x16::splat(0);
+        for &c in &self.cdf {
+            let c = F64x8::splat(c);
+            let below = Mask16::from_halves(c.le(u_lo), c.le(u_hi));
+            count = count + U32x16::select(below, one, U32x16::splat(0));
+        }
+        let index = U32x16::select(count.eq(U32x16::splat(0)), count, count - one);
+        let last = U32x16::splat(n as u32 - 1);
+        let index = U32x16::select(last.lt(index), last, index);
+        // cdf[index] and cdf[index + 1].
+        let (mut lo, mut hi) = ([F64x8::splat(0.0); 2], [F64x8::splat(1.0); 2]);
+        for k in 0..n {
+            let (at_lo, at_hi) = index.eq(U32x16::splat(k as u32)).halves();
+            for (h, at) in [at_lo, at_hi].into_iter().enumerate() {
+                lo[h] = F64x8::select(at, F64x8::splat(self.cdf[k]), lo[h]);
+                hi[h] = F64x8::select(at, F64x8::splat(self.cdf[k + 1]), hi[h]);
+            }
+        }
+        let zero = F64x8::splat(0.0);
+        let remap = |u: F64x8, lo: F64x8, hi: F64x8| {
+            let width = hi - lo;
+            let positive = width.gt(zero);
+            (F64x8::select(positive, (u - lo) / width, zero), positive)
+        };
+        let (r_lo, pos_lo) = remap(u_lo, lo[0], hi[0]);
+        let (r_hi, pos_hi) = remap(u_hi, lo[1], hi[1]);
+        let remapped = F32x16::select(
+            Mask16::from_halves(pos_lo, pos_hi),
+            F32x16::from_f64_halves(r_lo, r_hi),
+            F32x16::splat(0.0),
+        );
+        let pmf = F32x16::gather(&self.pmf, index, m);
+        let index = U32x16::select(m, index, U32x16::splat(0));
+        let remapped = F32x16::select(m, clamp(remapped), F32x16::splat(0.0));
+        (index, pmf, remapped)
     }
 
     /// Probability of item `i`.
@@ -226,6 +299,53 @@ impl Distribution2D {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn lanes_sample_as_the_scalar_code_does() {
+        let weights: Vec<Vec<f32>> = vec![
+            vec![2.0],
+            vec![1.0, 3.0],
+            vec![0.0, 1.0, 0.0, 0.5, 1e-30],
+            (0..16).map(|i| (i % 5) as f32).collect(),
+            (0..40).map(|i| 1.0 + (i % 3) as f32).collect(),
+        ];
+        let mut s = 0x2545_F491_4F6C_DD1Du64;
+        for w in &weights {
+            let d = Distribution1D::new(w).unwrap();
+            for round in 0..2000 {
+                let u: [f32; 16] = std::array::from_fn(|i| {
+                    s ^= s << 13;
+                    s ^= s >> 7;
+                    s ^= s << 17;
+                    match (round + i) % 7 {
+                        0 => 0.0,
+                        1 => 1.0 - f32::EPSILON / 2.0,
+                        2 => 1.0,
+                        _ => (s >> 40) as f32 / (1u64 << 24) as f32,
+                    }
+                });
+                let m = Mask16(0xffff ^ (1 << (round % 16)));
+                let (index, pmf, remapped) = d.sample_discrete_lanes(F32x16::from_array(u), m);
+                let (index, pmf, remapped) =
+                    (index.to_array(), pmf.to_array(), remapped.to_array());
+                for i in 0..16 {
+                    let want = if m.get(i) {
+                        d.sample_discrete(u[i])
+                    } else {
+                        (0, 0.0, 0.0)
+                    };
+                    let got = (index[i] as usize, pmf[i], remapped[i]);
+                    assert_eq!(
+                        (got.0, got.1.to_bits(), got.2.to_bits()),
+                        (want.0, want.1.to_bits(), want.2.to_bits()),
+                        "n {} u {}",
+                        w.len(),
+                        u[i]
+                    );
+                }
+            }
+        }
+    }
 
     #[test]
     fn discrete_probabilities_and_remapping() {

@@ -7,6 +7,7 @@
 //! having chosen the light an emitter hit belongs to.
 
 use crate::light::distribution::Distribution1D;
+use crate::math::lanes::{F32x16, Mask16, U32x16};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct LightSelection {
@@ -31,6 +32,14 @@ impl LightSelection {
     /// is no light to choose.
     pub fn sample(&self, u: f32) -> Option<(usize, f32, f32)> {
         self.by_power.as_ref().map(|d| d.sample_discrete(u))
+    }
+
+    /// `sample` for the lanes of `m` (`Distribution1D::sample_discrete_lanes`).
+    #[inline]
+    pub fn sample_lanes(&self, u: F32x16, m: Mask16) -> Option<(U32x16, F32x16, F32x16)> {
+        self.by_power
+            .as_ref()
+            .map(|d| d.sample_discrete_lanes(u, m))
     }
 
     /// Probability of choosing light `i`.

@@ -54,6 +54,7 @@ use glam::{Vec2, Vec3};
 
 use crate::error::{Error, Location, Result};
 use crate::geometry::SurfaceInteraction;
+use crate::math::lanes::{F32x16, Mask16, U32x16, V3};
 use crate::math::{Frame, PI, Rgb, warp};
 use crate::scene::{EmitterDesc, SceneDescription, ShapeDesc, ShapeGeometry};
 
@@ -93,6 +94,21 @@ pub struct LightSample {
     /// density for lights at infinity).
     pub pdf_area: f32,
     pub delta: bool,
+}
+
+/// `LightSample`s of area lights in sixteen lanes (`Light::sample_li_lanes`): the lanes of
+/// `ok` have a sample. Their points lie at a finite distance, are not deltas, and their
+/// `front` is `n`.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSampleLanes {
+    pub ok: Mask16,
+    pub p: V3<F32x16>,
+    pub n: V3<F32x16>,
+    pub p_error: V3<F32x16>,
+    pub wi: V3<F32x16>,
+    pub radiance: V3<F32x16>,
+    pub pdf_solid_angle: F32x16,
+    pub pdf_area: f32,
 }
 
 /// From reference point `r` towards a light at `position`: (unit direction, distance,
@@ -416,6 +432,31 @@ impl Light {
         ok.then_some(s)
     }
 
+    /// `sample_li` for the lanes of `m` (reference points `r`, 2D samples `ux`, `uy`),
+    /// lane by lane the same bits; None for lights the lanes cannot sample (all but area
+    /// lights on meshes without vertex normals).
+    #[inline]
+    pub fn sample_li_lanes(
+        &self,
+        r: V3<F32x16>,
+        ux: F32x16,
+        uy: F32x16,
+        m: Mask16,
+    ) -> Option<LightSampleLanes> {
+        let Light::Area(l) = self else {
+            return None;
+        };
+        let mut s = l.sample_li_lanes(r, ux, uy, m)?;
+        // The checks of `sample_li`.
+        if !(l.radiance.is_valid_radiance() && s.pdf_area.is_finite()) {
+            s.ok = Mask16::NONE;
+        }
+        s.ok &= s.pdf_solid_angle.gt(F32x16::splat(0.0))
+            & s.pdf_solid_angle.is_finite()
+            & s.wi.is_finite();
+        Some(s)
+    }
+
     /// Solid-angle density of `sample_li(ref_point, ·)` producing `hit` (0 for delta lights).
     /// A density too large for f32 (a light seen from astronomically far away) is 0: no
     /// sample could have been drawn there either (`sample_li` drops such samples).
@@ -567,6 +608,13 @@ impl LightSet {
     /// Chooses a light by power: (index, probability, `u` rescaled for reuse).
     pub fn sample(&self, u: f32) -> Option<(usize, f32, f32)> {
         self.selection.sample(u)
+    }
+
+    /// `sample` for the lanes of `m`: (index, probability, `u` rescaled) per lane; None
+    /// when there is no light to choose.
+    #[inline]
+    pub fn sample_lanes(&self, u: F32x16, m: Mask16) -> Option<(U32x16, F32x16, F32x16)> {
+        self.selection.sample_lanes(u, m)
     }
 
     /// Probability that `sample` chooses light `i`.

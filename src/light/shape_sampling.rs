@@ -18,6 +18,7 @@ use glam::{DMat4, DVec3, Mat4, Vec2, Vec3};
 
 use crate::geometry::offset::gamma;
 use crate::light::distribution::Distribution1D;
+use crate::math::lanes::{F32x16, Mask16, Real, V3};
 use crate::math::{Frame, PI, Transform, warp};
 use crate::scene::{ShapeDesc, ShapeGeometry, TriangleMesh};
 
@@ -118,6 +119,31 @@ impl ShapeSampler {
         })
     }
 
+    /// `sample_from` for the lanes of `m`, lane by lane the same bits; None where the lanes
+    /// cannot sample this shape (spheres, disks, meshes with vertex normals).
+    #[inline]
+    pub fn sample_from_lanes(
+        &self,
+        r: V3<F32x16>,
+        ux: F32x16,
+        uy: F32x16,
+        m: Mask16,
+    ) -> Option<ShapeSampleLanes> {
+        let ShapeSampler::Mesh(mesh) = self else {
+            return None;
+        };
+        let point = mesh.sample_area_lanes(ux, uy, m)?;
+        let pdf_area = 1.0 / self.area();
+        let pdf_solid_angle = area_to_solid_angle_in(F32x16::splat(pdf_area), r, point.p, point.n);
+        let ok = m & pdf_solid_angle.gt(F32x16::splat(0.0)) & pdf_solid_angle.is_finite();
+        Some(ShapeSampleLanes {
+            ok,
+            point,
+            pdf_solid_angle,
+            pdf_area,
+        })
+    }
+
     /// The solid-angle density with which `sample_from(r, ·)` produces point `p` (normal
     /// `n`) of this shape; 0 where that density is not finite.
     pub fn pdf_from(&self, r: Vec3, p: Vec3, n: Vec3) -> f32 {
@@ -134,13 +160,21 @@ impl ShapeSampler {
 /// Converts an area density at `p` (normal `n`) into a solid-angle density seen from `r`:
 /// pdf_A · d² / |cos θ| (0 when the distance is 0, infinite when seen edge-on).
 fn area_to_solid_angle(pdf_area: f32, r: Vec3, p: Vec3, n: Vec3) -> f32 {
+    area_to_solid_angle_in(pdf_area, V3::from(r), V3::from(p), V3::from(n))
+}
+
+/// `area_to_solid_angle` over `Real` (one density, or sixteen in lanes).
+#[inline(always)]
+fn area_to_solid_angle_in<T: Real>(pdf_area: T, r: V3<T>, p: V3<T>, n: V3<T>) -> T {
     let d = p - r;
     let dist2 = d.length_squared();
-    if dist2.is_nan() || dist2 <= 0.0 {
-        return 0.0;
-    }
     let cos = n.dot(d).abs() / dist2.sqrt();
-    pdf_area * dist2 / cos
+    // 0 for a NaN or zero distance.
+    T::select(
+        dist2.gt(T::splat(0.0)),
+        pdf_area * dist2 / cos,
+        T::splat(0.0),
+    )
 }
 
 /// Uniform-by-area sampling of a triangle mesh.
@@ -155,6 +189,33 @@ pub struct MeshSampler {
     /// Over the kept triangles, by area.
     by_area: Distribution1D,
     area: f32,
+    /// The triangles laid out for gathers by lane, when the lanes can sample this mesh
+    /// (it has no vertex normals).
+    lanes: Option<Box<MeshLanes>>,
+}
+
+/// Each kept triangle's vertex coordinates (v0.x, v0.y, v0.z, v1.x, …, v2.z) and normal
+/// (n.x, n.y, n.z), one table per coordinate, indexed by triangle.
+#[derive(Clone, Debug, PartialEq)]
+struct MeshLanes {
+    coords: [Vec<f32>; 12],
+}
+
+/// Points on a shape, one per lane (see `ShapePoint`; `front` is `n` for them).
+#[derive(Clone, Copy, Debug)]
+pub struct ShapePointLanes {
+    pub p: V3<F32x16>,
+    pub n: V3<F32x16>,
+    pub p_error: V3<F32x16>,
+}
+
+/// `ShapeSample`s in lanes: the lanes of `ok` have a point (as `sample_from` returns Some).
+#[derive(Clone, Copy, Debug)]
+pub struct ShapeSampleLanes {
+    pub ok: Mask16,
+    pub point: ShapePointLanes,
+    pub pdf_solid_angle: F32x16,
+    pub pdf_area: f32,
 }
 
 impl MeshSampler {
@@ -197,6 +258,21 @@ impl MeshSampler {
         if !(area > 0.0 && area.is_finite()) {
             return Err(format!("the emitting mesh has an unusable area ({total})"));
         }
+        let lanes = vertex_normals.is_none().then(|| {
+            let coords = std::array::from_fn(|k| {
+                (0..triangles.len())
+                    .map(|t| {
+                        let v = if k < 9 {
+                            triangles[t][k / 3]
+                        } else {
+                            normals[t]
+                        };
+                        v[k % 3]
+                    })
+                    .collect()
+            });
+            Box::new(MeshLanes { coords })
+        });
         Ok(MeshSampler {
             triangles,
             normals,
@@ -204,6 +280,7 @@ impl MeshSampler {
             primitives,
             by_area,
             area,
+            lanes,
         })
     }
 
@@ -234,6 +311,24 @@ impl MeshSampler {
             p_error: (v0.abs() * b0 + v1.abs() * b.x + v2.abs() * b.y) * gamma(6),
             primitive: self.primitives[i],
         }
+    }
+
+    /// `sample_area` for the lanes of `m`, lane by lane the same bits; None for a mesh with
+    /// vertex normals (sampled one lane at a time).
+    #[inline]
+    pub fn sample_area_lanes(&self, ux: F32x16, uy: F32x16, m: Mask16) -> Option<ShapePointLanes> {
+        let lanes = self.lanes.as_ref()?;
+        let (i, _, ux) = self.by_area.sample_discrete_lanes(ux, m);
+        let (b1, b2) = warp::triangle_barycentrics(ux, uy);
+        let g = |k: usize| F32x16::gather(&lanes.coords[k], i, m);
+        let vertex = |j: usize| V3::new(g(3 * j), g(3 * j + 1), g(3 * j + 2));
+        let (v0, v1, v2) = (vertex(0), vertex(1), vertex(2));
+        let b0 = F32x16::splat(1.0) - b1 - b2;
+        Some(ShapePointLanes {
+            p: v0 * b0 + v1 * b1 + v2 * b2,
+            n: vertex(3),
+            p_error: (v0.abs() * b0 + v1.abs() * b1 + v2.abs() * b2) * F32x16::splat(gamma(6)),
+        })
     }
 }
 

@@ -11,8 +11,15 @@ use crate::math::{INV_PI, PI};
 
 /// Uniform point on a triangle as barycentrics (b1, b2) (Shirley & Chiu 1997 square-root map).
 pub fn square_to_triangle(u: Vec2) -> Vec2 {
-    let su = u.x.sqrt();
-    Vec2::new(1.0 - su, u.y * su)
+    let (b1, b2) = triangle_barycentrics(u.x, u.y);
+    Vec2::new(b1, b2)
+}
+
+/// `square_to_triangle` over `Real` (one point, or sixteen in lanes).
+#[inline(always)]
+pub fn triangle_barycentrics<T: Real>(ux: T, uy: T) -> (T, T) {
+    let su = ux.sqrt();
+    (T::splat(1.0) - su, uy * su)
 }
 
 /// Uniform direction on the unit sphere; pdf 1/(4π).

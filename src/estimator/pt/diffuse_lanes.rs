@@ -6,19 +6,20 @@
 use super::PathSample;
 use super::hit_lanes::HitLanes;
 use super::lane_scene::LaneScene;
-use super::path_lanes::{PathLanes, lane, lane3};
+use super::path_lanes::{PathLanes, lane, lane3, put3, with_lane};
 use crate::geometry::offset::offset_origin;
 use crate::geometry::{Ray, SHADOW_EPSILON};
+use crate::light::Light;
 use crate::math::INV_PI;
 use crate::math::frame::LaneFrame;
-use crate::math::lanes::{F32x16, LANES, Mask16, U32x16, V3};
+use crate::math::lanes::{F32x16, Mask16, U32x16, V3};
 use crate::math::warp::cosine_hemisphere;
 use crate::path::mis::power_heuristic;
 use crate::scene::Scene;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 
-/// What next-event estimation drew per lane (`Light::sample_li` and the light's choice).
-struct LightSampleLanes {
+/// What next-event estimation drew per lane: the light's choice and `Light::sample_li`.
+struct NeeLanes {
     /// Lanes with a sample (a light was chosen and returned a point).
     ok: Mask16,
     p: V3<F32x16>,
@@ -34,69 +35,77 @@ struct LightSampleLanes {
     delta: Mask16,
 }
 
-impl LightSampleLanes {
-    /// Chooses a light and a point on it for every lane of `m`, one lane at a time.
+impl NeeLanes {
+    /// Chooses a light and a point on it for every lane of `m` (as `sample_light` does):
+    /// in lanes for the lights that can (`Light::sample_li_lanes`), one lane at a time for
+    /// the others.
     fn sample(
         scene: &Scene,
         p: &V3<F32x16>,
         u_light: F32x16,
         u: (F32x16, F32x16),
         m: Mask16,
-    ) -> LightSampleLanes {
-        let mut ok = Mask16::NONE;
-        let mut finite = Mask16::NONE;
-        let mut delta = Mask16::NONE;
-        let mut v = [[[0.0f32; 3]; LANES]; 5];
-        let (mut pdf, mut pmf_l) = ([0.0f32; LANES], [0.0f32; LANES]);
-        let (u_light, ux, uy) = (u_light.to_array(), u.0.to_array(), u.1.to_array());
+    ) -> NeeLanes {
+        let zero = F32x16::splat(0.0);
+        let zero3 = V3::new(zero, zero, zero);
+        let mut out = NeeLanes {
+            ok: Mask16::NONE,
+            p: zero3,
+            n: zero3,
+            p_error: zero3,
+            wi: zero3,
+            finite: Mask16::NONE,
+            radiance: zero3,
+            pdf_solid_angle: zero,
+            pmf: zero,
+            delta: Mask16::NONE,
+        };
+        let Some((index, pmf, _)) = scene.lights.sample_lanes(u_light, m) else {
+            return out;
+        };
+        out.pmf = pmf;
+        // One light at a time: the lanes that chose it.
+        let chosen = index.to_array();
+        let mut todo = m;
+        while let Some(first) = todo.lanes().next() {
+            let light = scene.lights.get(chosen[first] as usize);
+            let same = todo & index.eq(U32x16::splat(chosen[first]));
+            todo &= !same;
+            match light.sample_li_lanes(*p, u.0, u.1, same) {
+                Some(s) => {
+                    out.ok |= s.ok;
+                    out.finite |= same;
+                    out.p = V3::select(same, s.p, out.p);
+                    out.n = V3::select(same, s.n, out.n);
+                    out.p_error = V3::select(same, s.p_error, out.p_error);
+                    out.wi = V3::select(same, s.wi, out.wi);
+                    out.radiance = V3::select(same, s.radiance, out.radiance);
+                    out.pdf_solid_angle =
+                        F32x16::select(same, s.pdf_solid_angle, out.pdf_solid_angle);
+                }
+                None => out.sample_one_by_one(light, p, u, same),
+            }
+        }
+        out
+    }
+
+    /// `Light::sample_li` lane by lane, for the lanes of `m`.
+    fn sample_one_by_one(&mut self, light: &Light, p: &V3<F32x16>, u: (F32x16, F32x16), m: Mask16) {
         for i in m.lanes() {
-            let Some((index, pmf, _)) = scene.lights.sample(u_light[i]) else {
-                continue;
-            };
-            let Some(ls) = scene
-                .lights
-                .get(index)
-                .sample_li(lane3(p, i), Vec2::new(ux[i], uy[i]))
+            let Some(ls) = light.sample_li(lane3(p, i), Vec2::new(lane(u.0, i), lane(u.1, i)))
             else {
                 continue;
             };
-            ok.set(i, true);
-            finite.set(i, ls.dist.is_finite());
-            delta.set(i, ls.delta);
+            self.ok.set(i, true);
+            self.finite.set(i, ls.dist.is_finite());
+            self.delta.set(i, ls.delta);
+            put3(&mut self.p, i, ls.p);
+            put3(&mut self.n, i, ls.n);
+            put3(&mut self.p_error, i, ls.p_error);
+            put3(&mut self.wi, i, ls.wi);
             let rad = ls.radiance;
-            for (k, x) in [
-                ls.p,
-                ls.n,
-                ls.p_error,
-                ls.wi,
-                glam::Vec3::new(rad.r(), rad.g(), rad.b()),
-            ]
-            .iter()
-            .enumerate()
-            {
-                v[k][i] = x.to_array();
-            }
-            pdf[i] = ls.pdf_solid_angle;
-            pmf_l[i] = pmf;
-        }
-        let to_lanes = |k: usize| {
-            V3::new(
-                F32x16::from_array(std::array::from_fn(|i| v[k][i][0])),
-                F32x16::from_array(std::array::from_fn(|i| v[k][i][1])),
-                F32x16::from_array(std::array::from_fn(|i| v[k][i][2])),
-            )
-        };
-        LightSampleLanes {
-            ok,
-            p: to_lanes(0),
-            n: to_lanes(1),
-            p_error: to_lanes(2),
-            wi: to_lanes(3),
-            finite,
-            radiance: to_lanes(4),
-            pdf_solid_angle: F32x16::from_array(pdf),
-            pmf: F32x16::from_array(pmf_l),
-            delta,
+            put3(&mut self.radiance, i, Vec3::new(rad.r(), rad.g(), rad.b()));
+            self.pdf_solid_angle = with_lane(self.pdf_solid_angle, i, ls.pdf_solid_angle);
         }
     }
 }
@@ -154,7 +163,7 @@ impl PathSample {
         // Next-event estimation (`sample_light`).
         let u_light = lanes.streams.next_1d(m);
         let u = lanes.streams.next_2d(m);
-        let ls = LightSampleLanes::sample(scene, &hits.p, u_light, u, m);
+        let ls = NeeLanes::sample(scene, &hits.p, u_light, u, m);
         let wi = frame.to_local(ls.wi);
         let inv_pi = F32x16::splat(INV_PI);
         // Diffuse::eval: R/π where both directions are above the surface, black elsewhere.
