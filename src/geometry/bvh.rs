@@ -31,6 +31,7 @@ pub use stream::IN_FLIGHT;
 use super::cwbvh;
 use super::flat::{FLAT_LIMIT, FlatTriangles};
 use super::offset::gamma;
+use super::packet::PacketTriangles;
 use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord};
 
 /// Binary BVH settings for `n` triangles: obvhs's `fast_build` preset (PLOC with a short
@@ -154,6 +155,8 @@ pub struct TriangleBvh {
     /// when there are at most `FLAT_LIMIT` triangles (`nodes` is then empty; otherwise
     /// this is).
     flat: FlatTriangles,
+    /// The same records for sixteen rays at a time (`packet.rs`), also only when flat.
+    packet: PacketTriangles,
 }
 
 impl TriangleBvh {
@@ -214,15 +217,17 @@ impl TriangleBvh {
         });
         // A flat scene keeps no nodes: `is_flat` is the emptiness test the tree's queries make
         // anyway.
-        let (nodes, flat) = if records.len() <= flat_limit {
-            (Vec::new(), FlatTriangles::new(&records))
+        let (nodes, flat, packet) = if records.len() <= flat_limit {
+            let packet = PacketTriangles::new(&records);
+            (Vec::new(), FlatTriangles::new(&records), packet)
         } else {
             let nodes = collect_large(wide.nodes.par_iter().copied());
-            (nodes, FlatTriangles::default())
+            (nodes, FlatTriangles::default(), PacketTriangles::default())
         };
         TriangleBvh {
             nodes,
             flat,
+            packet,
             records,
             normals,
             uvs,
@@ -238,6 +243,16 @@ impl TriangleBvh {
 
     pub fn record(&self, index: u32) -> &TriangleRecord {
         &self.records[index as usize]
+    }
+
+    /// All records, in the order the queries number them.
+    pub fn records(&self) -> &[TriangleRecord] {
+        &self.records
+    }
+
+    /// The records laid out for sixteen rays at a time; empty unless `is_flat`.
+    pub fn packet(&self) -> &PacketTriangles {
+        &self.packet
     }
 
     /// Vertex normals of record `index`, if its mesh has them.
@@ -519,6 +534,7 @@ impl Default for TriangleBvh {
             depth: 0,
             bounds: (Vec3::INFINITY, Vec3::NEG_INFINITY),
             flat: FlatTriangles::default(),
+            packet: PacketTriangles::default(),
         }
     }
 }

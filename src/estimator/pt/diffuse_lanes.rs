@@ -7,8 +7,9 @@ use super::PathSample;
 use super::hit_lanes::HitLanes;
 use super::lane_scene::LaneScene;
 use super::path_lanes::{PathLanes, lane, lane3, put3, with_lane};
+use crate::geometry::SHADOW_EPSILON;
 use crate::geometry::offset::offset_origin;
-use crate::geometry::{Ray, SHADOW_EPSILON};
+use crate::geometry::packet::RayLanes;
 use crate::light::Light;
 use crate::math::INV_PI;
 use crate::math::frame::LaneFrame;
@@ -184,15 +185,12 @@ impl PathSample {
             F32x16::splat(1.0 - SHADOW_EPSILON),
             F32x16::splat(f32::INFINITY),
         );
-        let mut lit = Mask16::NONE;
-        for i in shoot.lanes() {
-            let ray = Ray {
-                o: lane3(&origin, i),
-                d: lane3(&dir, i),
-                t_max: lane(t_max, i),
-            };
-            lit.set(i, !scene.geometry.occluded(&ray));
-        }
+        let shadow = RayLanes {
+            o: origin,
+            d: dir,
+            t_max,
+        };
+        let lit = shoot & !scene.geometry.occluded_lanes(&shadow, shoot);
         lanes.rays = lanes.rays + U32x16::select(shoot, U32x16::splat(1), U32x16::splat(0));
         let pdf_light = ls.pmf * ls.pdf_solid_angle;
         // Diffuse::pdf: the cosine density where wo is above the surface.

@@ -2,8 +2,9 @@
 //! (position and its error bound, normals, shape) as lanes, and each lane's whole
 //! `SurfaceInteraction` for the scalar code.
 
-use super::path_lanes::{PathLanes, lane, lane3};
-use crate::geometry::{Ray, SurfaceInteraction};
+use super::path_lanes::PathLanes;
+use crate::geometry::SurfaceInteraction;
+use crate::geometry::packet::RayLanes;
 use crate::math::lanes::{F32x16, LANES, Mask16, U32x16, V3};
 use crate::scene::Scene;
 
@@ -39,13 +40,15 @@ impl HitLanes {
         );
         let mut shape = [0u32; LANES];
         let mut hit = Mask16::NONE;
+        let rays = RayLanes {
+            o: lanes.origin,
+            d: lanes.direction,
+            t_max: lanes.t_max,
+        };
+        let found = scene.geometry.closest_hits_lanes(&rays, lanes.live);
         for i in lanes.live.lanes() {
-            let ray = Ray {
-                o: lane3(&lanes.origin, i),
-                d: lane3(&lanes.direction, i),
-                t_max: lane(lanes.t_max, i),
-            };
-            if let Some(si) = scene.geometry.intersect(&ray) {
+            if let Some(closest) = &found[i] {
+                let si = scene.geometry.interaction(closest);
                 hit.set(i, true);
                 p[i] = si.p.to_array();
                 p_error[i] = si.p_error.to_array();

@@ -119,8 +119,15 @@ impl PathSample {
         // lanes only check the depth.
         let light = U32x16::gather(&tables.light, hits.shape, hits.hit);
         let emitter = hits.hit & !light.eq(U32x16::splat(NO_LIGHT)) & lanes.shows_emitters;
-        let mut ended = Mask16::NONE;
-        for lane in ((live & !hits.hit) | emitter).lanes() {
+        // An escaped ray ends the path; only the environment's lights add to it.
+        let escaped = live & !hits.hit;
+        let mut ended = escaped;
+        let sees_environment = if scene.lights.environment().is_empty() {
+            Mask16::NONE
+        } else {
+            escaped & lanes.shows_environment
+        };
+        for lane in (sees_environment | emitter).lanes() {
             let mut state = lanes.get(lane);
             if !self.arrive(scene, &mut state, hits.interaction(lane)) {
                 ended.set(lane, true);
@@ -148,11 +155,16 @@ impl PathSample {
         }
 
         // Finished paths go to the queue.
+        let (r, g, b) = (
+            lanes.result.x.to_array(),
+            lanes.result.y.to_array(),
+            lanes.result.z.to_array(),
+        );
+        let rays = lanes.rays.to_array();
         for lane in ended.lanes() {
-            let state = lanes.get(lane);
             let q = &mut queue[lanes.sample[lane] as usize];
-            q.value = state.result;
-            q.rays = state.rays;
+            q.value = Rgb::new(r[lane], g[lane], b[lane]);
+            q.rays = rays[lane] as u64;
         }
         lanes.live = live & !ended;
     }

@@ -194,6 +194,12 @@ impl F32x16 {
         })
     }
 
+    /// Lane i of the result is lane `idx[i] mod 16` of `self`.
+    #[inline(always)]
+    pub fn permute(self, idx: U32x16) -> F32x16 {
+        F32x16(unsafe { _mm512_permutexvar_ps(idx.0, self.0) })
+    }
+
     /// Lanes 0–7 and 8–15 widened to f64 (exact).
     #[inline(always)]
     pub fn to_f64_halves(self) -> (F64x8, F64x8) {
@@ -244,9 +250,16 @@ impl U32x16 {
         U32x16(unsafe { _mm512_srli_epi32::<N>(self.0) })
     }
 
+    /// Unsigned minimum.
     #[inline(always)]
-    fn min(self, o: U32x16) -> U32x16 {
+    pub fn min(self, o: U32x16) -> U32x16 {
         U32x16(unsafe { _mm512_min_epu32(self.0, o.0) })
+    }
+
+    /// Unsigned maximum.
+    #[inline(always)]
+    pub fn max(self, o: U32x16) -> U32x16 {
+        U32x16(unsafe { _mm512_max_epu32(self.0, o.0) })
     }
 
     #[inline(always)]

@@ -202,6 +202,12 @@ impl F32x16 {
         }))
     }
 
+    /// Lane i of the result is lane `idx[i] mod 16` of `self`.
+    #[inline(always)]
+    pub fn permute(self, idx: U32x16) -> F32x16 {
+        F32x16(std::array::from_fn(|i| self.0[idx.0[i] as usize % 16]))
+    }
+
     /// Lanes 0–7 and 8–15 widened to f64 (exact).
     #[inline(always)]
     pub fn to_f64_halves(self) -> (F64x8, F64x8) {
@@ -248,6 +254,18 @@ impl U32x16 {
     #[inline(always)]
     pub fn shr<const N: u32>(self) -> U32x16 {
         U32x16(self.0.map(|a| a >> N))
+    }
+
+    /// Unsigned minimum.
+    #[inline(always)]
+    pub fn min(self, o: U32x16) -> U32x16 {
+        U32x16(std::array::from_fn(|i| self.0[i].min(o.0[i])))
+    }
+
+    /// Unsigned maximum.
+    #[inline(always)]
+    pub fn max(self, o: U32x16) -> U32x16 {
+        U32x16(std::array::from_fn(|i| self.0[i].max(o.0[i])))
     }
 
     #[inline(always)]

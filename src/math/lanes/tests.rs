@@ -236,6 +236,13 @@ fn integer_lane_operations_equal_scalar_ones() {
         assert_eq!(x.shl::<3>().to_array(), a.map(|v| v << 3));
         assert_eq!(x.shr::<5>().to_array(), a.map(|v| v >> 5));
         assert_eq!(x.to_f32().to_array(), a.map(|v| v as f32));
+        assert_eq!(x.min(y).to_array(), std::array::from_fn(|i| a[i].min(b[i])));
+        assert_eq!(x.max(y).to_array(), std::array::from_fn(|i| a[i].max(b[i])));
+        let f = F32x16::from_array(std::array::from_fn(|i| i as f32 * 0.5));
+        let p = f.permute(x).to_array();
+        for i in 0..16 {
+            assert_eq!(p[i], (a[i] % 16) as f32 * 0.5);
+        }
         for i in 0..16 {
             assert_eq!(x.lt(y).get(i), a[i] < b[i]);
             assert_eq!(x.eq(y).get(i), a[i] == b[i]);

@@ -1,0 +1,406 @@
+//! Sixteen rays at once on a small scene: each triangle tested against all sixteen, one
+//! ray per lane (`Geometry::closest_hits_lanes`, `Geometry::occluded_lanes`).
+//!
+//! `flat.rs` tests one ray against sixteen triangles; here the lanes hold rays, so the
+//! watertight test's per-ray axis permutation becomes a per-lane one (a permute of the
+//! triangle's twelve coordinates), and each lane keeps its own closest hit without a
+//! horizontal search. The arithmetic is the per-triangle test's (`triangle.rs`), operation
+//! for operation, so each lane reports exactly what `Geometry::closest_hit` and `occluded`
+//! report for its ray: a lane whose edge functions are all non-zero and whose T exceeds its
+//! rounding error bound is settled from its own values; any other candidate goes through
+//! `triangle::intersect` itself. `tests/geometry.rs` compares both queries ray by ray.
+//!
+//! Scenes with a tree, and the analytic shapes of small scenes, are answered one lane at a
+//! time by the per-ray queries.
+
+use super::triangle::{self, BoundArithmetic, TriangleHit, TriangleRay, TriangleRecord};
+use super::{ClosestHit, Geometry, Hit, Ray, ScaledRay};
+use crate::math::lanes::{F32x16, LANES, Mask16, U32x16, V3};
+
+/// Sixteen rays: origins, directions (need not be unit length) and segment ends.
+#[derive(Clone, Copy, Debug)]
+pub struct RayLanes {
+    pub o: V3<F32x16>,
+    pub d: V3<F32x16>,
+    pub t_max: F32x16,
+}
+
+impl RayLanes {
+    /// Lane `i` as a `Ray`.
+    pub fn lane(&self, i: usize) -> Ray {
+        let g = |v: F32x16| v.to_array()[i];
+        Ray {
+            o: glam::Vec3::new(g(self.o.x), g(self.o.y), g(self.o.z)),
+            d: glam::Vec3::new(g(self.d.x), g(self.d.y), g(self.d.z)),
+            t_max: g(self.t_max),
+        }
+    }
+}
+
+impl BoundArithmetic for F32x16 {
+    #[inline(always)]
+    fn splat(v: f32) -> F32x16 {
+        F32x16::splat(v)
+    }
+}
+
+/// One triangle record as one vector: coordinate k of vertex j in lane 4k + j (lanes 3, 7,
+/// 11 hold the record's identity, lanes 12–15 are unused).
+#[derive(Clone, Copy)]
+#[repr(C, align(64))]
+struct PacketTriangle([f32; LANES]);
+
+/// The records of a small scene, one vector each, for the sixteen-ray tests.
+#[derive(Clone, Default)]
+pub struct PacketTriangles {
+    triangles: Vec<PacketTriangle>,
+}
+
+impl PacketTriangles {
+    pub fn new(records: &[TriangleRecord]) -> PacketTriangles {
+        let triangles = records
+            .iter()
+            .map(|r| {
+                let mut v = [0.0f32; LANES];
+                for (k, row) in r.rows.iter().enumerate() {
+                    v[4 * k..4 * k + 4].copy_from_slice(row);
+                }
+                PacketTriangle(v)
+            })
+            .collect();
+        PacketTriangles { triangles }
+    }
+}
+
+/// `ScaledRay::new` in lanes: `valid` where the ray can hit anything.
+struct ScaledRayLanes {
+    valid: Mask16,
+    o: V3<F32x16>,
+    d: V3<F32x16>,
+    scale: F32x16,
+    inv_scale: F32x16,
+    t_max: F32x16,
+}
+
+impl ScaledRayLanes {
+    #[inline(always)]
+    fn new(r: &RayLanes) -> ScaledRayLanes {
+        let a = r.d.abs();
+        // `Vec3::max_element`.
+        let m = a.x.max_gt(a.y).max_gt(a.z);
+        let zero = F32x16::splat(0.0);
+        let valid = m.gt(zero) & m.is_finite() & r.o.is_finite() & r.t_max.gt(zero);
+        // The binary exponent of m clamped to [−126, 126], as its biased value in [1, 253].
+        let biased = (m.to_bits().shr::<23>() & U32x16::splat(0xff))
+            .max(U32x16::splat(1))
+            .min(U32x16::splat(253));
+        let scale = F32x16::from_bits(biased.shl::<23>());
+        let inv_scale = F32x16::from_bits((U32x16::splat(254) - biased).shl::<23>());
+        ScaledRayLanes {
+            valid,
+            o: r.o,
+            d: r.d * inv_scale,
+            scale,
+            inv_scale,
+            t_max: r.t_max * scale,
+        }
+    }
+
+    /// Lane `i` as the `ScaledRay` the per-ray query makes.
+    fn lane(&self, i: usize) -> ScaledRay {
+        let g = |v: F32x16| v.to_array()[i];
+        ScaledRay {
+            o: glam::Vec3::new(g(self.o.x), g(self.o.y), g(self.o.z)),
+            d: glam::Vec3::new(g(self.d.x), g(self.d.y), g(self.d.z)),
+            scale: g(self.scale),
+            inv_scale: g(self.inv_scale),
+            t_max: g(self.t_max),
+        }
+    }
+}
+
+/// Component `k` (0, 1, 2 per lane) of `v`.
+#[inline(always)]
+fn pick(v: &V3<F32x16>, k: U32x16) -> F32x16 {
+    F32x16::select(
+        k.eq(U32x16::splat(0)),
+        v.x,
+        F32x16::select(k.eq(U32x16::splat(1)), v.y, v.z),
+    )
+}
+
+/// `TriangleRay::new` in lanes: the permutation as indices into a `PacketTriangle`, the
+/// permuted origin and the shear.
+struct TriangleRayLanes {
+    /// For vertex j: the lanes of its kx, ky and kz coordinates.
+    index: [[U32x16; 3]; 3],
+    ox: F32x16,
+    oy: F32x16,
+    oz: F32x16,
+    sx: F32x16,
+    sy: F32x16,
+    sz: F32x16,
+}
+
+impl TriangleRayLanes {
+    /// `d` must be non-zero and finite in the lanes used.
+    #[inline(always)]
+    fn new(o: &V3<F32x16>, d: &V3<F32x16>) -> TriangleRayLanes {
+        let u = U32x16::splat;
+        let a = d.abs();
+        // kz = index of the largest |d| component (the first of equals).
+        let z_largest = a.z.gt(a.x.max_gt(a.y));
+        let kz = U32x16::select(z_largest, u(2), U32x16::select(a.y.gt(a.x), u(1), u(0)));
+        let kx0 = U32x16::select(kz.eq(u(0)), u(1), U32x16::select(kz.eq(u(1)), u(2), u(0)));
+        let ky0 = U32x16::select(kz.eq(u(0)), u(2), U32x16::select(kz.eq(u(1)), u(0), u(1)));
+        // A negative d[kz] swaps x and y to keep the winding.
+        let dz = pick(d, kz);
+        let negative = dz.lt(F32x16::splat(0.0));
+        let kx = U32x16::select(negative, ky0, kx0);
+        let ky = U32x16::select(negative, kx0, ky0);
+        let sz = F32x16::splat(1.0) / dz;
+        let lanes_of = |k: U32x16| std::array::from_fn(|j| k.shl::<2>() + u(j as u32));
+        let (ix, iy, iz): ([U32x16; 3], [U32x16; 3], [U32x16; 3]) =
+            (lanes_of(kx), lanes_of(ky), lanes_of(kz));
+        TriangleRayLanes {
+            index: std::array::from_fn(|j| [ix[j], iy[j], iz[j]]),
+            ox: pick(o, kx),
+            oy: pick(o, ky),
+            oz: pick(o, kz),
+            sx: pick(d, kx) * sz,
+            sy: pick(d, ky) * sz,
+            sz,
+        }
+    }
+}
+
+/// What the lanes computed for one triangle (see `lane_tests`).
+struct LaneTests {
+    e: [F32x16; 3],
+    det: F32x16,
+    /// t = T/det, meaningful in `settled` lanes.
+    t: F32x16,
+    /// Lanes that may pass the test within (0, t_max): the others certainly fail it.
+    candidate: Mask16,
+    /// Candidates decided here (no zero edge function, T above its error bound): they hit
+    /// at `t` if t < t_max. The other candidates need `triangle::intersect`.
+    settled: Mask16,
+}
+
+/// The watertight test of `tri` against the lanes of `m`, within (0, t_max) per lane.
+#[inline(always)]
+fn lane_tests(tri: &PacketTriangle, r: &TriangleRayLanes, t_max: F32x16, m: Mask16) -> LaneTests {
+    let v = F32x16::from_array(tri.0);
+    // Sheared vertex coordinates, as `triangle::intersect_scalar`.
+    let vertex = |j: usize| {
+        let [ix, iy, iz] = r.index[j];
+        let z = v.permute(iz) - r.oz;
+        let x = (v.permute(ix) - r.ox) - r.sx * z;
+        let y = (v.permute(iy) - r.oy) - r.sy * z;
+        (x, y, z)
+    };
+    let (x0, y0, z0) = vertex(0);
+    let (x1, y1, z1) = vertex(1);
+    let (x2, y2, z2) = vertex(2);
+    let e0 = x2 * y1 - y2 * x1;
+    let e1 = x0 * y2 - y0 * x2;
+    let e2 = x1 * y0 - y1 * x0;
+    let zero = F32x16::splat(0.0);
+    let any_neg = e0.lt(zero) | e1.lt(zero) | e2.lt(zero);
+    let any_pos = e0.gt(zero) | e1.gt(zero) | e2.gt(zero);
+    let all_nonzero = e0.ne(zero) & e1.ne(zero) & e2.ne(zero);
+    let det = (e0 + e1) + e2;
+    let t_num = (e0 * (z0 * r.sz) + e1 * (z1 * r.sz)) + e2 * (z2 * r.sz);
+    // t = T/det with both made positive, as `triangle::hit_from`.
+    let flip = det.lt(zero);
+    let t_num_p = F32x16::select(flip, -t_num, t_num);
+    let det_p = F32x16::select(flip, -det, det);
+    let in_range = t_num_p.gt(zero) & t_num_p.lt(t_max * det_p);
+    let candidate = m & !(any_neg & any_pos) & (!all_nonzero | in_range);
+    let mut out = LaneTests {
+        e: [e0, e1, e2],
+        det,
+        t: zero,
+        candidate,
+        settled: Mask16::NONE,
+    };
+    if candidate.none() {
+        return out;
+    }
+    // T's error bound from the largest |x|, |y|, |z| and |e|, as the per-triangle test.
+    let max3 = |a: F32x16, b: F32x16, c: F32x16| a.abs().max_gt(b.abs()).max_gt(c.abs());
+    let bound = triangle::t_num_error_bound_in(
+        max3(x0, x1, x2).max_gt(max3(y0, y1, y2)),
+        max3(z0, z1, z2),
+        max3(e0, e1, e2),
+        r.sz.abs(),
+    );
+    out.settled = candidate
+        & all_nonzero
+        & in_range
+        & bound.lt(t_num_p)
+        & bound.lt(F32x16::splat(f32::INFINITY));
+    out.t = t_num_p / det_p;
+    out
+}
+
+/// The closest hit found so far in each lane.
+struct BestLanes {
+    t: F32x16,
+    record: U32x16,
+    e: [F32x16; 3],
+    det: F32x16,
+    hit: Mask16,
+}
+
+impl BestLanes {
+    /// Takes `h` (on record `k`) as lane `i`'s closest hit.
+    fn set(&mut self, i: usize, k: u32, h: &TriangleHit) {
+        let m = Mask16(1 << i);
+        self.t = F32x16::select(m, F32x16::splat(h.t), self.t);
+        self.record = U32x16::select(m, U32x16::splat(k), self.record);
+        for (e, &v) in self.e.iter_mut().zip(&h.e) {
+            *e = F32x16::select(m, F32x16::splat(v), *e);
+        }
+        self.det = F32x16::select(m, F32x16::splat(h.det), self.det);
+        self.hit |= m;
+    }
+}
+
+impl PacketTriangles {
+    /// For each lane of `m`: the closest record with 0 < t < t_max, as the per-triangle test
+    /// finds it scanning the records in order (the first of equal t). `tri_ray(i)` is lane
+    /// i's ray for that test.
+    fn closest(
+        &self,
+        records: &[TriangleRecord],
+        r: &TriangleRayLanes,
+        tri_ray: impl Fn(usize) -> TriangleRay,
+        t_max: F32x16,
+        m: Mask16,
+    ) -> [Option<(u32, TriangleHit)>; LANES] {
+        let zero = F32x16::splat(0.0);
+        let mut best = BestLanes {
+            t: t_max,
+            record: U32x16::splat(0),
+            e: [zero; 3],
+            det: zero,
+            hit: Mask16::NONE,
+        };
+        for (k, tri) in self.triangles.iter().enumerate() {
+            let lanes = lane_tests(tri, r, best.t, m);
+            let closer = lanes.settled & lanes.t.lt(best.t);
+            best.t = F32x16::select(closer, lanes.t, best.t);
+            best.record = U32x16::select(closer, U32x16::splat(k as u32), best.record);
+            for (b, e) in best.e.iter_mut().zip(lanes.e) {
+                *b = F32x16::select(closer, e, *b);
+            }
+            best.det = F32x16::select(closer, lanes.det, best.det);
+            best.hit |= closer;
+            for i in (lanes.candidate & !lanes.settled).lanes() {
+                let t_max_i = best.t.to_array()[i];
+                if let Some(h) = triangle::intersect(&records[k], &tri_ray(i), t_max_i) {
+                    best.set(i, k as u32, &h);
+                }
+            }
+        }
+        let (t, record, det) = (
+            best.t.to_array(),
+            best.record.to_array(),
+            best.det.to_array(),
+        );
+        let e = best.e.map(|v| v.to_array());
+        std::array::from_fn(|i| {
+            best.hit.get(i).then(|| {
+                let hit = TriangleHit {
+                    t: t[i],
+                    e: [e[0][i], e[1][i], e[2][i]],
+                    det: det[i],
+                };
+                (record[i], hit)
+            })
+        })
+    }
+
+    /// The lanes of `m` for which some record lies at 0 < t < t_max.
+    fn any(
+        &self,
+        records: &[TriangleRecord],
+        r: &TriangleRayLanes,
+        tri_ray: impl Fn(usize) -> TriangleRay,
+        t_max: F32x16,
+        m: Mask16,
+    ) -> Mask16 {
+        let mut found = Mask16::NONE;
+        for (k, tri) in self.triangles.iter().enumerate() {
+            let open = m & !found;
+            if open.none() {
+                break;
+            }
+            let lanes = lane_tests(tri, r, t_max, open);
+            found |= lanes.settled & lanes.t.lt(t_max);
+            for i in (lanes.candidate & !lanes.settled).lanes() {
+                let t_max_i = t_max.to_array()[i];
+                if triangle::intersect(&records[k], &tri_ray(i), t_max_i).is_some() {
+                    found.set(i, true);
+                }
+            }
+        }
+        found
+    }
+}
+
+impl Geometry {
+    /// `closest_hit` for the rays of the lanes of `m` (None in the other lanes): the same
+    /// answers, sixteen rays per triangle test on a small scene without analytic shapes
+    /// (`packet.rs`), one ray at a time otherwise.
+    pub fn closest_hits_lanes(&self, rays: &RayLanes, m: Mask16) -> [Option<ClosestHit>; LANES] {
+        if !self.bvh.is_flat() || self.has_analytic_shapes() {
+            let mut out = [None; LANES];
+            for i in m.lanes() {
+                out[i] = self.closest_hit(&rays.lane(i));
+            }
+            return out;
+        }
+        let scaled = ScaledRayLanes::new(rays);
+        let m = m & scaled.valid;
+        let tri = TriangleRayLanes::new(&scaled.o, &scaled.d);
+        let tri_ray = |i: usize| {
+            let s = scaled.lane(i);
+            TriangleRay::new(s.o, s.d)
+        };
+        let hits = self
+            .bvh
+            .packet()
+            .closest(self.bvh.records(), &tri, tri_ray, scaled.t_max, m);
+        let mut out = [None; LANES];
+        for i in m.lanes() {
+            if let Some((record, hit)) = hits[i] {
+                out[i] = Some(self.found(Hit::Triangle { record, hit }, scaled.lane(i)));
+            }
+        }
+        out
+    }
+
+    /// `occluded` for the rays of the lanes of `m`: the lanes whose segment is blocked
+    /// (sixteen rays per triangle test where `closest_hits_lanes` uses it).
+    pub fn occluded_lanes(&self, rays: &RayLanes, m: Mask16) -> Mask16 {
+        if !self.bvh.is_flat() || self.has_analytic_shapes() {
+            return Mask16::from_fn(|i| m.get(i) && self.occluded(&rays.lane(i)));
+        }
+        let scaled = ScaledRayLanes::new(rays);
+        let m = m & scaled.valid;
+        let tri = TriangleRayLanes::new(&scaled.o, &scaled.d);
+        let tri_ray = |i: usize| {
+            let s = scaled.lane(i);
+            TriangleRay::new(s.o, s.d)
+        };
+        self.bvh
+            .packet()
+            .any(self.bvh.records(), &tri, tri_ray, scaled.t_max, m)
+    }
+
+    fn has_analytic_shapes(&self) -> bool {
+        !(self.spheres.is_empty() && self.disks.is_empty())
+    }
+}
