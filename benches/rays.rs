@@ -23,10 +23,12 @@ use std::time::Duration;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 use mltbench::geometry::bvh::{TraversalRay, TriangleBvh, TriangleList};
+use mltbench::geometry::packet::RayLanes;
 use mltbench::geometry::procedural::{
     cornell_box, cornell_box_with_sphere, displaced_sphere_1m, mesh_shape, uv_sphere,
 };
 use mltbench::geometry::{Geometry, Ray};
+use mltbench::math::lanes::{F32x16, Mask16, V3};
 use mltbench::scene::ShapeDesc;
 use rayon::prelude::*;
 
@@ -308,7 +310,43 @@ fn bench_cornell_queries(c: &mut Criterion) {
     group.bench_function("anyhit_half_segments/1t", |b| {
         b.iter(|| shadow.iter().filter(|r| geometry.occluded(r)).count())
     });
+    // The same rays sixteen at a time (`geometry::packet`), as `pt`'s wavefront casts them.
+    let (packets, shadow_packets) = (to_packets(&rays), to_packets(&shadow));
+    group.bench_function("packet_kernel_incoherent/1t", |b| {
+        b.iter(|| {
+            packets
+                .iter()
+                .map(|p| {
+                    let hits = geometry.closest_hits_lanes(p, Mask16::ALL);
+                    black_box(&hits).iter().filter(|h| h.is_some()).count()
+                })
+                .sum::<usize>()
+        })
+    });
+    group.bench_function("packet_anyhit_half_segments/1t", |b| {
+        b.iter(|| {
+            shadow_packets
+                .iter()
+                .map(|p| geometry.occluded_lanes(p, Mask16::ALL).count() as usize)
+                .sum::<usize>()
+        })
+    });
     group.finish();
+}
+
+/// `rays` in packets of sixteen (the count must be a multiple of 16).
+fn to_packets(rays: &[Ray]) -> Vec<RayLanes> {
+    rays.chunks_exact(16)
+        .map(|c| {
+            let lanes =
+                |f: &dyn Fn(&Ray) -> f32| F32x16::from_array(std::array::from_fn(|i| f(&c[i])));
+            RayLanes {
+                o: V3::new(lanes(&|r| r.o.x), lanes(&|r| r.o.y), lanes(&|r| r.o.z)),
+                d: V3::new(lanes(&|r| r.d.x), lanes(&|r| r.d.y), lanes(&|r| r.d.z)),
+                t_max: lanes(&|r| r.t_max),
+            }
+        })
+        .collect()
 }
 
 criterion_group! {

@@ -45,6 +45,8 @@ pub use thin_lens::ThinLens;
 use glam::{Vec2, Vec3};
 
 use crate::geometry::Ray;
+use crate::geometry::packet::RayLanes;
+use crate::math::lanes::{F32x16, Real, U32x16, V3};
 use crate::scene::{FovAxis, SensorDesc};
 
 /// A pinhole (`<sensor type="perspective">`) or thin-lens (`<sensor type="thinlens">`)
@@ -190,13 +192,46 @@ impl Camera {
 
     /// The camera-space direction (not normalised, z = 1) through raster position `raster`.
     fn camera_direction(&self, raster: Vec2) -> Vec3 {
-        let u = (raster.x + self.offset.x) / self.film_width as f32;
-        let v = (raster.y + self.offset.y) / self.film_height as f32;
-        Vec3::new(
-            (1.0 - 2.0 * u) * self.tan_half_x,
-            (1.0 - 2.0 * v) * self.tan_half_x / self.aspect,
-            1.0,
+        self.camera_direction_in(raster.x, raster.y).into()
+    }
+
+    /// `camera_direction` over `Real` (one raster position, or sixteen in lanes).
+    #[inline(always)]
+    fn camera_direction_in<T: Real>(&self, x: T, y: T) -> V3<T> {
+        let c = T::splat;
+        let u = (x + c(self.offset.x)) / c(self.film_width as f32);
+        let v = (y + c(self.offset.y)) / c(self.film_height as f32);
+        V3::new(
+            (c(1.0) - c(2.0) * u) * c(self.tan_half_x),
+            (c(1.0) - c(2.0) * v) * c(self.tan_half_x) / c(self.aspect),
+            c(1.0),
         )
+    }
+
+    /// `generate_ray` for sixteen raster positions (x, y per lane), lane by lane the same
+    /// bits; only for a pinhole camera (None with a lens).
+    pub fn generate_ray_lanes(&self, x: F32x16, y: F32x16) -> Option<RayLanes> {
+        if self.lens.is_some() {
+            return None;
+        }
+        let d_camera = self.camera_direction_in(x, y).normalize();
+        let m = &self.to_world.matrix;
+        // `Mat4::transform_vector3`: x_axis·v.x + y_axis·v.y + z_axis·v.z, per row.
+        let row = |k: usize| {
+            let c = |v: glam::Vec4| F32x16::splat(v[k]);
+            c(m.x_axis) * d_camera.x + c(m.y_axis) * d_camera.y + c(m.z_axis) * d_camera.z
+        };
+        let d = V3::new(row(0), row(1), row(2)).normalize();
+        let inv_z = F32x16::splat(1.0) / d_camera.z;
+        let near_t = F32x16::splat(self.near_clip) * inv_z;
+        let far_t = F32x16::splat(self.far_clip) * inv_z;
+        let p = self.position;
+        let origin = V3::new(F32x16::splat(p.x), F32x16::splat(p.y), F32x16::splat(p.z));
+        Some(RayLanes {
+            o: origin + d * near_t,
+            d,
+            t_max: far_t - near_t,
+        })
     }
 
     /// The primary ray through raster position `raster` (continuous pixel coordinates:
@@ -436,6 +471,20 @@ impl Camera {
             importance,
         })
     }
+}
+
+/// `raster_in_pixel` for sixteen pixels (x, y) and offsets (ux, uy), lane by lane the same
+/// bits.
+pub fn raster_in_pixel_lanes(x: U32x16, y: U32x16, ux: F32x16, uy: F32x16) -> (F32x16, F32x16) {
+    let inside = |i: U32x16, t: F32x16| {
+        let lo = i.to_f32();
+        let p = lo + t;
+        let hi = lo + F32x16::splat(1.0);
+        // The float below hi (hi ≥ 1: one step down in its bits).
+        let below = F32x16::from_bits(hi.to_bits() - U32x16::splat(1));
+        F32x16::select(p.lt(hi), p, below)
+    };
+    (inside(x, ux), inside(y, uy))
 }
 
 /// A raster position inside pixel (x, y) at offset `u` ∈ [0, 1)², guaranteed to round

@@ -106,16 +106,27 @@ impl ScaledRayLanes {
         }
     }
 
-    /// Lane `i` as the `ScaledRay` the per-ray query makes.
-    fn lane(&self, i: usize) -> ScaledRay {
-        let g = |v: F32x16| v.to_array()[i];
-        ScaledRay {
-            o: glam::Vec3::new(g(self.o.x), g(self.o.y), g(self.o.z)),
-            d: glam::Vec3::new(g(self.d.x), g(self.d.y), g(self.d.z)),
-            scale: g(self.scale),
-            inv_scale: g(self.inv_scale),
-            t_max: g(self.t_max),
-        }
+    /// Every lane as the `ScaledRay` the per-ray query makes.
+    fn lanes(&self) -> [ScaledRay; LANES] {
+        let [ox, oy, oz, dx, dy, dz, scale, inv_scale, t_max] = [
+            self.o.x,
+            self.o.y,
+            self.o.z,
+            self.d.x,
+            self.d.y,
+            self.d.z,
+            self.scale,
+            self.inv_scale,
+            self.t_max,
+        ]
+        .map(F32x16::to_array);
+        std::array::from_fn(|i| ScaledRay {
+            o: glam::Vec3::new(ox[i], oy[i], oz[i]),
+            d: glam::Vec3::new(dx[i], dy[i], dz[i]),
+            scale: scale[i],
+            inv_scale: inv_scale[i],
+            t_max: t_max[i],
+        })
     }
 }
 
@@ -365,10 +376,8 @@ impl Geometry {
         let scaled = ScaledRayLanes::new(rays);
         let m = m & scaled.valid;
         let tri = TriangleRayLanes::new(&scaled.o, &scaled.d);
-        let tri_ray = |i: usize| {
-            let s = scaled.lane(i);
-            TriangleRay::new(s.o, s.d)
-        };
+        let per_ray = scaled.lanes();
+        let tri_ray = |i: usize| TriangleRay::new(per_ray[i].o, per_ray[i].d);
         let hits = self
             .bvh
             .packet()
@@ -376,7 +385,7 @@ impl Geometry {
         let mut out = [None; LANES];
         for i in m.lanes() {
             if let Some((record, hit)) = hits[i] {
-                out[i] = Some(self.found(Hit::Triangle { record, hit }, scaled.lane(i)));
+                out[i] = Some(self.found(Hit::Triangle { record, hit }, per_ray[i]));
             }
         }
         out
@@ -392,7 +401,7 @@ impl Geometry {
         let m = m & scaled.valid;
         let tri = TriangleRayLanes::new(&scaled.o, &scaled.d);
         let tri_ray = |i: usize| {
-            let s = scaled.lane(i);
+            let s = &scaled.lanes()[i];
             TriangleRay::new(s.o, s.d)
         };
         self.bvh

@@ -17,10 +17,11 @@ pub fn mix64(mut z: u64) -> u64 {
 
 /// Hashes a list of words into one seed; order matters.
 pub fn hash_words(words: &[u64]) -> u64 {
-    words
-        .iter()
-        .fold(0x6A09_E667_F3BC_C909, |h, &w| mix64(h ^ mix64(w)))
+    words.iter().fold(HASH_START, |h, &w| mix64(h ^ mix64(w)))
 }
+
+/// Where `hash_words` starts (the first 64 bits of the fractional part of √2).
+pub(crate) const HASH_START: u64 = 0x6A09_E667_F3BC_C909;
 
 /// Uniform random samples, seeded from (seed, pixel, sample index).
 pub struct IndependentSampler {

@@ -7,6 +7,7 @@
 //! draw advances only the lanes of its mask; the others keep their state, as a path that
 //! draws nothing at that step would.
 
+use super::independent::HASH_START;
 use crate::math::lanes::{F32x16, Mask16, U32x16, U64x8};
 
 /// The states of sixteen Xoshiro256++ generators: word k of lanes 0–7 in `s[k][0]`, of
@@ -35,10 +36,37 @@ impl LaneStreams {
         }
     }
 
+    /// Lanes `m` start the streams of samples `index` of pixels (x, y) (per lane), as
+    /// `IndependentSampler::start_pixel_sample` seeds them: the hash of (seed, x, y, index)
+    /// expanded by SplitMix64 into the four state words.
+    pub fn start_pixel_samples(&mut self, m: Mask16, seed: u64, x: U32x16, y: U32x16, index: u64) {
+        let (x_lo, x_hi) = x.to_u64_halves();
+        let (y_lo, y_hi) = y.to_u64_halves();
+        let (m_lo, m_hi) = m.halves();
+        for (h, (px, py, keep)) in [(x_lo, y_lo, m_lo), (x_hi, y_hi, m_hi)]
+            .into_iter()
+            .enumerate()
+        {
+            let key = hash_words_lanes(&[U64x8::splat(seed), px, py, U64x8::splat(index)]);
+            // SplitMix64 seeded with `key` (rand_xoshiro's `seed_from_u64`): word k is the
+            // finaliser of key + (k + 1)·φ, which `mix64` of key + k·φ is.
+            let mut x = key;
+            for k in 0..4 {
+                self.s[k][h] = U64x8::select(keep, mix64_lanes(x), self.s[k][h]);
+                x = x + U64x8::splat(GOLDEN_GAMMA);
+            }
+        }
+    }
+
     /// The state of lane `lane`'s stream.
     pub fn lane(&self, lane: usize) -> [u64; 4] {
         let (half, i) = (lane / 8, lane % 8);
         std::array::from_fn(|k| self.s[k][half].to_array()[i])
+    }
+
+    #[cfg(test)]
+    fn clone_states(&self) -> [[u64; 4]; 16] {
+        std::array::from_fn(|i| self.lane(i))
     }
 
     /// The next 64-bit output of the lanes of `m` (other lanes: unspecified), advancing
@@ -88,6 +116,26 @@ impl LaneStreams {
     }
 }
 
+/// SplitMix64's increment φ (the golden ratio times 2⁶⁴).
+const GOLDEN_GAMMA: u64 = 0x9E37_79B9_7F4A_7C15;
+
+/// `independent::mix64` per lane.
+#[inline(always)]
+fn mix64_lanes(z: U64x8) -> U64x8 {
+    let z = z + U64x8::splat(GOLDEN_GAMMA);
+    let z = (z ^ z.shr::<30>()) * U64x8::splat(0xBF58_476D_1CE4_E5B9);
+    let z = (z ^ z.shr::<27>()) * U64x8::splat(0x94D0_49BB_1331_11EB);
+    z ^ z.shr::<31>()
+}
+
+/// `independent::hash_words` per lane.
+#[inline(always)]
+fn hash_words_lanes(words: &[U64x8]) -> U64x8 {
+    words.iter().fold(U64x8::splat(HASH_START), |h, &w| {
+        mix64_lanes(h ^ mix64_lanes(w))
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -124,10 +172,35 @@ mod tests {
         }
         for (i, s) in samplers.iter().enumerate() {
             assert_eq!(lanes.lane(i), s.state());
+        }
+        for (i, s) in samplers.iter().enumerate() {
             // A sampler continued from the lane's state draws on identically.
             let mut a = IndependentSampler::with_state(17, lanes.lane(i));
             let mut b = IndependentSampler::with_state(17, s.state());
             assert_eq!(a.next_1d(), b.next_1d());
+        }
+    }
+
+    #[test]
+    fn lanes_start_pixel_samples_as_the_sampler_does() {
+        let mut lanes = LaneStreams::default();
+        for i in 0..16 {
+            lanes.set_lane(i, [i as u64, 7, 9, 11]);
+        }
+        let m = Mask16(0b1011_1111_0111_1101);
+        let xs = U32x16::from_array(std::array::from_fn(|i| 3 * i as u32 + 1));
+        let ys = U32x16::from_array(std::array::from_fn(|i| 1000 - i as u32));
+        let before = lanes.clone_states();
+        lanes.start_pixel_samples(m, 17, xs, ys, 5_000_000_000);
+        for i in 0..16 {
+            let want = if m.get(i) {
+                let mut s = IndependentSampler::new(17);
+                s.start_pixel_sample((3 * i as u32 + 1, 1000 - i as u32), 5_000_000_000);
+                s.state()
+            } else {
+                before[i]
+            };
+            assert_eq!(lanes.lane(i), want, "lane {i}");
         }
     }
 }

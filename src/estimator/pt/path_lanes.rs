@@ -6,6 +6,7 @@ use glam::Vec3;
 
 use super::{PathState, PreviousVertex};
 use crate::geometry::Ray;
+use crate::geometry::packet::RayLanes;
 use crate::math::Rgb;
 use crate::math::lanes::{F32x16, LANES, Mask16, U32x16, V3};
 use crate::sampler::lane_streams::LaneStreams;
@@ -91,6 +92,32 @@ impl Default for PathLanes {
 }
 
 impl PathLanes {
+    /// Lanes `m` start paths along camera rays `rays` (as `PathSample::start`), emitters
+    /// and the environment shown to the camera unless `hide_emitters`.
+    pub fn start(&mut self, m: Mask16, rays: &RayLanes, hide_emitters: bool) {
+        let zero = F32x16::splat(0.0);
+        let one = F32x16::splat(1.0);
+        self.origin = V3::select(m, rays.o, self.origin);
+        self.direction = V3::select(m, rays.d, self.direction);
+        self.t_max = F32x16::select(m, rays.t_max, self.t_max);
+        self.result = V3::select(m, V3::new(zero, zero, zero), self.result);
+        self.throughput = V3::select(m, V3::new(one, one, one), self.throughput);
+        self.eta = F32x16::select(m, one, self.eta);
+        self.prev_p = V3::select(m, rays.o, self.prev_p);
+        self.prev_pdf = F32x16::select(m, one, self.prev_pdf);
+        self.prev_specular |= m;
+        if hide_emitters {
+            self.shows_emitters &= !m;
+            self.shows_environment &= !m;
+        } else {
+            self.shows_emitters |= m;
+            self.shows_environment |= m;
+        }
+        self.depth = U32x16::select(m, U32x16::splat(0), self.depth);
+        self.rays = U32x16::select(m, U32x16::splat(0), self.rays);
+        self.live |= m;
+    }
+
     /// The path in lane `i`.
     pub fn get(&self, i: usize) -> PathState {
         let rgb = |v: &V3<F32x16>| {

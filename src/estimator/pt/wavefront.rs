@@ -18,11 +18,13 @@ use super::PathSample;
 use super::hit_lanes::HitLanes;
 use super::lane_scene::NO_LIGHT;
 use super::path_lanes::PathLanes;
+use crate::camera::raster_in_pixel_lanes;
 use crate::estimator::camera_pass::{PassContext, PassCounts, start_camera_sample};
 use crate::film::{FilmTile, PixelRect};
 use crate::math::Rgb;
-use crate::math::lanes::{Mask16, U32x16};
+use crate::math::lanes::{LANES, Mask16, U32x16};
 use crate::sampler::IndependentSampler;
+use crate::sampler::pixel_samples::PixelSamples;
 
 /// Tiles of 16×16 pixels per task: 1024 paths keep the lanes full for most of a batch.
 pub(super) const TILES_PER_TASK: usize = 4;
@@ -56,7 +58,15 @@ impl PathSample {
         let mut lanes = PathLanes::default();
         let mut next = 0usize;
         let mut sampler = pass.camera_sampler();
+        // Camera samples start in lanes where they can: independent pixel samples, a
+        // pinhole camera, paths of at least one segment.
+        let start_in_lanes = matches!(**pass.pixel_samples, PixelSamples::Independent)
+            && !pass.scene.camera.has_lens()
+            && self.max_depth() > 0;
         loop {
+            if start_in_lanes {
+                next = self.start_in_lanes(pass, &mut lanes, &mut queue, next);
+            }
             // Empty lanes take the next camera samples.
             for lane in (!lanes.live).lanes() {
                 while next < queue.len() && !lanes.live.get(lane) {
@@ -98,6 +108,48 @@ impl PathSample {
                 (tile, counts)
             })
             .collect()
+    }
+
+    /// Empty lanes take the next camera samples of `queue` (from index `next`), started in
+    /// lanes as `start_camera_sample` and `start` would; returns the new `next`.
+    fn start_in_lanes(
+        &self,
+        pass: &PassContext,
+        lanes: &mut PathLanes,
+        queue: &mut [QueuedSample],
+        mut next: usize,
+    ) -> usize {
+        let (mut x, mut y) = ([0u32; LANES], [0u32; LANES]);
+        let mut m = Mask16::NONE;
+        for lane in (!lanes.live).lanes() {
+            if next == queue.len() {
+                break;
+            }
+            (x[lane], y[lane]) = queue[next].pixel;
+            lanes.sample[lane] = next as u32;
+            m.set(lane, true);
+            next += 1;
+        }
+        if m.none() {
+            return next;
+        }
+        let (x, y) = (U32x16::from_array(x), U32x16::from_array(y));
+        lanes
+            .streams
+            .start_pixel_samples(m, pass.seed, x, y, pass.pass_index as u64);
+        let (ux, uy) = lanes.streams.next_2d(m);
+        let (rx, ry) = raster_in_pixel_lanes(x, y, ux, uy);
+        let rays = pass
+            .scene
+            .camera
+            .generate_ray_lanes(rx, ry)
+            .expect("lanes start camera samples only for a pinhole");
+        lanes.start(m, &rays, self.settings.hide_emitters);
+        let (rx, ry) = (rx.to_array(), ry.to_array());
+        for lane in m.lanes() {
+            queue[lanes.sample[lane] as usize].raster = Vec2::new(rx[lane], ry[lane]);
+        }
+        next
     }
 
     /// Advances every live lane by one vertex; lanes whose path ends write it to `queue`.

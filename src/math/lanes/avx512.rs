@@ -69,6 +69,30 @@ binary_ops!(U64x8,
     BitXor bitxor _mm512_xor_si512,
 );
 
+/// Wrapping 64-bit products: one instruction with AVX-512DQ, three 32-bit products without.
+impl Mul for U64x8 {
+    type Output = U64x8;
+    #[inline(always)]
+    fn mul(self, o: U64x8) -> U64x8 {
+        #[cfg(target_feature = "avx512dq")]
+        {
+            U64x8(unsafe { _mm512_mullo_epi64(self.0, o.0) })
+        }
+        #[cfg(not(target_feature = "avx512dq"))]
+        {
+            // a·b mod 2⁶⁴ = lo(a)·lo(b) + ((lo(a)·hi(b) + hi(a)·lo(b)) << 32).
+            unsafe {
+                let lo = _mm512_mul_epu32(self.0, o.0);
+                let cross = _mm512_add_epi64(
+                    _mm512_mul_epu32(self.0, _mm512_srli_epi64::<32>(o.0)),
+                    _mm512_mul_epu32(_mm512_srli_epi64::<32>(self.0), o.0),
+                );
+                U64x8(_mm512_add_epi64(lo, _mm512_slli_epi64::<32>(cross)))
+            }
+        }
+    }
+}
+
 const SIGN: u32 = 0x8000_0000;
 
 impl Neg for F32x16 {
@@ -298,6 +322,19 @@ impl U32x16 {
     #[inline(always)]
     pub fn to_f32(self) -> F32x16 {
         F32x16(unsafe { _mm512_cvtepu32_ps(self.0) })
+    }
+
+    /// Lanes 0–7 and 8–15 widened to u64.
+    #[inline(always)]
+    pub fn to_u64_halves(self) -> (U64x8, U64x8) {
+        unsafe {
+            let lo = _mm512_castsi512_si256(self.0);
+            let hi = _mm512_extracti64x4_epi64::<1>(self.0);
+            (
+                U64x8(_mm512_cvtepu32_epi64(lo)),
+                U64x8(_mm512_cvtepu32_epi64(hi)),
+            )
+        }
     }
 
     /// The low 32 bits of each u64 lane of `lo` (lanes 0–7) and `hi` (lanes 8–15).

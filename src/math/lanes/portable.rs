@@ -62,6 +62,7 @@ binary_ops!(F64x8, 8,
 );
 binary_ops!(U64x8, 8,
     Add add |a: u64, b: u64| a.wrapping_add(b),
+    Mul mul |a: u64, b: u64| a.wrapping_mul(b),
     BitAnd bitand |a: u64, b: u64| a & b,
     BitOr bitor |a: u64, b: u64| a | b,
     BitXor bitxor |a: u64, b: u64| a ^ b,
@@ -304,6 +305,15 @@ impl U32x16 {
     #[inline(always)]
     pub fn to_f32(self) -> F32x16 {
         F32x16(self.0.map(|a| a as f32))
+    }
+
+    /// Lanes 0–7 and 8–15 widened to u64.
+    #[inline(always)]
+    pub fn to_u64_halves(self) -> (U64x8, U64x8) {
+        (
+            U64x8(std::array::from_fn(|i| self.0[i] as u64)),
+            U64x8(std::array::from_fn(|i| self.0[8 + i] as u64)),
+        )
     }
 
     /// The low 32 bits of each u64 lane of `lo` (lanes 0–7) and `hi` (lanes 8–15).

@@ -237,6 +237,9 @@ fn integer_lane_operations_equal_scalar_ones() {
         assert_eq!(x.shr::<5>().to_array(), a.map(|v| v >> 5));
         assert_eq!(x.to_f32().to_array(), a.map(|v| v as f32));
         assert_eq!(x.min(y).to_array(), std::array::from_fn(|i| a[i].min(b[i])));
+        let (lo, hi) = x.to_u64_halves();
+        let wide: Vec<u64> = lo.to_array().into_iter().chain(hi.to_array()).collect();
+        assert_eq!(wide, a.map(|v| v as u64).to_vec());
         assert_eq!(x.max(y).to_array(), std::array::from_fn(|i| a[i].max(b[i])));
         let f = F32x16::from_array(std::array::from_fn(|i| i as f32 * 0.5));
         let p = f.permute(x).to_array();
@@ -255,6 +258,10 @@ fn integer_lane_operations_equal_scalar_ones() {
             std::array::from_fn(|i| wa[i].wrapping_add(wb[i]))
         );
         assert_eq!((p ^ q).to_array(), std::array::from_fn(|i| wa[i] ^ wb[i]));
+        assert_eq!(
+            (p * q).to_array(),
+            std::array::from_fn(|i| wa[i].wrapping_mul(wb[i]))
+        );
         assert_eq!(p.shl::<17>().to_array(), wa.map(|v| v << 17));
         assert_eq!(p.shr::<11>().to_array(), wa.map(|v| v >> 11));
         assert_eq!(p.rotl::<45>().to_array(), wa.map(|v| v.rotate_left(45)));
