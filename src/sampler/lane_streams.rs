@@ -192,13 +192,13 @@ mod tests {
         let ys = U32x16::from_array(std::array::from_fn(|i| 1000 - i as u32));
         let before = lanes.clone_states();
         lanes.start_pixel_samples(m, 17, xs, ys, 5_000_000_000);
-        for i in 0..16 {
+        for (i, &old) in before.iter().enumerate() {
             let want = if m.get(i) {
                 let mut s = IndependentSampler::new(17);
                 s.start_pixel_sample((3 * i as u32 + 1, 1000 - i as u32), 5_000_000_000);
                 s.state()
             } else {
-                before[i]
+                old
             };
             assert_eq!(lanes.lane(i), want, "lane {i}");
         }
