@@ -318,7 +318,7 @@ fn bench_cornell_queries(c: &mut Criterion) {
                 .iter()
                 .map(|p| {
                     let hits = geometry.closest_hits_lanes(p, Mask16::ALL);
-                    black_box(&hits).iter().filter(|h| h.is_some()).count()
+                    black_box(&hits).hit.count() as usize
                 })
                 .sum::<usize>()
         })

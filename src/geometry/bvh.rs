@@ -218,7 +218,7 @@ impl TriangleBvh {
         // A flat scene keeps no nodes: `is_flat` is the emptiness test the tree's queries make
         // anyway.
         let (nodes, flat, packet) = if records.len() <= flat_limit {
-            let packet = PacketTriangles::new(&records);
+            let packet = PacketTriangles::new(&records, normals.as_deref());
             (Vec::new(), FlatTriangles::new(&records), packet)
         } else {
             let nodes = collect_large(wide.nodes.par_iter().copied());

@@ -46,18 +46,20 @@ impl BoundArithmetic for F32x16 {
 
 /// One triangle record as one vector: coordinate k of vertex j in lane 4k + j (lanes 3, 7,
 /// 11 hold the record's identity, lanes 12–15 are unused).
-#[derive(Clone, Copy)]
-#[repr(C, align(64))]
-struct PacketTriangle([f32; LANES]);
+type PacketTriangle = [f32; LANES];
 
-/// The records of a small scene, one vector each, for the sixteen-ray tests.
+/// The records of a small scene, one vector each, for the sixteen-ray tests, and their
+/// vertex normals for the surface data.
 #[derive(Clone, Default)]
 pub struct PacketTriangles {
     triangles: Vec<PacketTriangle>,
+    /// Per record, the three vertex normals' coordinates (n0.x, n0.y, …, n2.z; zero for a
+    /// mesh without normals), when some mesh has them.
+    normals: Option<Vec<f32>>,
 }
 
 impl PacketTriangles {
-    pub fn new(records: &[TriangleRecord]) -> PacketTriangles {
+    pub fn new(records: &[TriangleRecord], normals: Option<&[[glam::Vec3; 3]]>) -> PacketTriangles {
         let triangles = records
             .iter()
             .map(|r| {
@@ -65,10 +67,15 @@ impl PacketTriangles {
                 for (k, row) in r.rows.iter().enumerate() {
                     v[4 * k..4 * k + 4].copy_from_slice(row);
                 }
-                PacketTriangle(v)
+                v
             })
             .collect();
-        PacketTriangles { triangles }
+        let normals = normals.map(|n| {
+            n.iter()
+                .flat_map(|tri| tri.iter().flat_map(|v| v.to_array()))
+                .collect()
+        });
+        PacketTriangles { triangles, normals }
     }
 }
 
@@ -201,7 +208,7 @@ struct LaneTests {
 /// The watertight test of `tri` against the lanes of `m`, within (0, t_max) per lane.
 #[inline(always)]
 fn lane_tests(tri: &PacketTriangle, r: &TriangleRayLanes, t_max: F32x16, m: Mask16) -> LaneTests {
-    let v = F32x16::from_array(tri.0);
+    let v = F32x16::from_array(*tri);
     // Sheared vertex coordinates, as `triangle::intersect_scalar`.
     let vertex = |j: usize| {
         let [ix, iy, iz] = r.index[j];
@@ -289,7 +296,7 @@ impl PacketTriangles {
         tri_ray: impl Fn(usize) -> TriangleRay,
         t_max: F32x16,
         m: Mask16,
-    ) -> [Option<(u32, TriangleHit)>; LANES] {
+    ) -> BestLanes {
         let zero = F32x16::splat(0.0);
         let mut best = BestLanes {
             t: t_max,
@@ -315,22 +322,7 @@ impl PacketTriangles {
                 }
             }
         }
-        let (t, record, det) = (
-            best.t.to_array(),
-            best.record.to_array(),
-            best.det.to_array(),
-        );
-        let e = best.e.map(|v| v.to_array());
-        std::array::from_fn(|i| {
-            best.hit.get(i).then(|| {
-                let hit = TriangleHit {
-                    t: t[i],
-                    e: [e[0][i], e[1][i], e[2][i]],
-                    det: det[i],
-                };
-                (record[i], hit)
-            })
-        })
+        best
     }
 
     /// The lanes of `m` for which some record lies at 0 < t < t_max.
@@ -361,34 +353,167 @@ impl PacketTriangles {
     }
 }
 
+/// The closest hits of sixteen rays (`Geometry::closest_hits_lanes`).
+pub struct ClosestLanes {
+    /// Lanes whose ray hit something.
+    pub hit: Mask16,
+    found: Found,
+}
+
+/// How `ClosestLanes` found its hits.
+enum Found {
+    /// By the sixteen-ray test: per lane the closest record and its hit (t in the scaled
+    /// ray's units), and the scaled rays.
+    Packet {
+        best: BestLanes,
+        rays: Box<[ScaledRay; LANES]>,
+    },
+    /// By the per-ray query, lane after lane.
+    OneByOne(Box<[Option<ClosestHit>; LANES]>),
+}
+
+impl ClosestLanes {
+    /// Lane `i`'s hit as the per-ray query `closest_hit` returns it.
+    pub fn closest_hit(&self, geometry: &Geometry, i: usize) -> Option<ClosestHit> {
+        match &self.found {
+            Found::OneByOne(hits) => hits[i],
+            Found::Packet { best, rays } => self.hit.get(i).then(|| {
+                let g = |v: F32x16| v.to_array()[i];
+                let hit = TriangleHit {
+                    t: g(best.t),
+                    e: best.e.map(g),
+                    det: g(best.det),
+                };
+                let record = best.record.to_array()[i];
+                geometry.found(Hit::Triangle { record, hit }, rays[i])
+            }),
+        }
+    }
+}
+
+/// Surface data of sixteen hits, as `SurfaceInteraction` holds it (meaningful in the
+/// lanes of `hit`): the parts a wavefront reads for every hit.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfaceLanes {
+    pub hit: Mask16,
+    pub p: V3<F32x16>,
+    pub p_error: V3<F32x16>,
+    pub ng: V3<F32x16>,
+    pub ns: V3<F32x16>,
+    pub shape: U32x16,
+    pub primitive: U32x16,
+}
+
 impl Geometry {
-    /// `closest_hit` for the rays of the lanes of `m` (None in the other lanes): the same
-    /// answers, sixteen rays per triangle test on a small scene without analytic shapes
-    /// (`packet.rs`), one ray at a time otherwise.
-    pub fn closest_hits_lanes(&self, rays: &RayLanes, m: Mask16) -> [Option<ClosestHit>; LANES] {
+    /// `closest_hit` for the rays of the lanes of `m`: the same answers, sixteen rays per
+    /// triangle test on a small scene without analytic shapes (`packet.rs`), one ray at a
+    /// time otherwise.
+    pub fn closest_hits_lanes(&self, rays: &RayLanes, m: Mask16) -> ClosestLanes {
         if !self.bvh.is_flat() || self.has_analytic_shapes() {
-            let mut out = [None; LANES];
+            let mut hits = Box::new([None; LANES]);
             for i in m.lanes() {
-                out[i] = self.closest_hit(&rays.lane(i));
+                hits[i] = self.closest_hit(&rays.lane(i));
             }
-            return out;
+            return ClosestLanes {
+                hit: Mask16::from_fn(|i| hits[i].is_some()),
+                found: Found::OneByOne(hits),
+            };
         }
         let scaled = ScaledRayLanes::new(rays);
         let m = m & scaled.valid;
         let tri = TriangleRayLanes::new(&scaled.o, &scaled.d);
-        let per_ray = scaled.lanes();
+        let per_ray = Box::new(scaled.lanes());
         let tri_ray = |i: usize| TriangleRay::new(per_ray[i].o, per_ray[i].d);
-        let hits = self
+        let best = self
             .bvh
             .packet()
             .closest(self.bvh.records(), &tri, tri_ray, scaled.t_max, m);
-        let mut out = [None; LANES];
-        for i in m.lanes() {
-            if let Some((record, hit)) = hits[i] {
-                out[i] = Some(self.found(Hit::Triangle { record, hit }, per_ray[i]));
-            }
+        ClosestLanes {
+            hit: best.hit,
+            found: Found::Packet {
+                best,
+                rays: per_ray,
+            },
         }
-        out
+    }
+
+    /// The surface data of `hits`: in lanes for the sixteen-ray test's hits, through
+    /// `interaction` lane by lane otherwise. Lane by lane the same bits as `interaction`.
+    pub fn surface_lanes(&self, hits: &ClosestLanes) -> SurfaceLanes {
+        let Found::Packet { best, .. } = &hits.found else {
+            return self.surface_one_by_one(hits);
+        };
+        let m = hits.hit;
+        let packet = self.bvh.packet();
+        let table = packet.triangles.as_flattened();
+        let base = best.record.shl::<4>();
+        let at = |lane: u32| F32x16::gather(table, base + U32x16::splat(lane), m);
+        let vertex = |j: u32| V3::new(at(j), at(4 + j), at(8 + j));
+        let v = [vertex(0), vertex(1), vertex(2)];
+        // `TriangleHit::barycentrics`.
+        let inv = F32x16::splat(1.0) / best.det;
+        let b = best.e.map(|e| e * inv);
+        let (p, p_error) = triangle::hit_point_in(v, b);
+        let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
+        let ns = match &packet.normals {
+            None => ng,
+            Some(normals) => {
+                // The interpolated vertex normal, normalised, where the record has normals
+                // and it does not vanish (`triangle_interaction`).
+                let base = best.record.shl::<3>() + best.record;
+                let n = |j: u32| {
+                    let c = |k: u32| F32x16::gather(normals, base + U32x16::splat(3 * j + k), m);
+                    V3::new(c(0), c(1), c(2))
+                };
+                let n = [n(0), n(1), n(2)];
+                let zero = F32x16::splat(0.0);
+                let is_zero = |v: &V3<F32x16>| v.x.eq(zero) & v.y.eq(zero) & v.z.eq(zero);
+                let none = is_zero(&n[0]) & is_zero(&n[1]) & is_zero(&n[2]);
+                let interpolated = n[0] * b[0] + n[1] * b[1] + n[2] * b[2];
+                let rcp = F32x16::splat(1.0) / interpolated.length();
+                let ok = !none & rcp.is_finite() & rcp.gt(zero);
+                V3::select(ok, interpolated * rcp, ng)
+            }
+        };
+        let (shape, primitive) = triangle::ids_lanes([at(3), at(7), at(11)].map(F32x16::to_bits));
+        SurfaceLanes {
+            hit: m,
+            p,
+            p_error,
+            ng,
+            ns,
+            shape,
+            primitive,
+        }
+    }
+
+    /// `surface_lanes` through `interaction`, one lane at a time.
+    fn surface_one_by_one(&self, hits: &ClosestLanes) -> SurfaceLanes {
+        let mut v = [[[0.0f32; 3]; LANES]; 4];
+        let (mut shape, mut primitive) = ([0u32; LANES], [0u32; LANES]);
+        for i in hits.hit.lanes() {
+            let Some(h) = hits.closest_hit(self, i) else {
+                continue;
+            };
+            let si = self.interaction(&h);
+            for (k, x) in [si.p, si.p_error, si.ng, si.ns].iter().enumerate() {
+                v[k][i] = x.to_array();
+            }
+            (shape[i], primitive[i]) = (si.shape, si.primitive);
+        }
+        let lanes = |k: usize| {
+            let c = |axis: usize| F32x16::from_array(std::array::from_fn(|i| v[k][i][axis]));
+            V3::new(c(0), c(1), c(2))
+        };
+        SurfaceLanes {
+            hit: hits.hit,
+            p: lanes(0),
+            p_error: lanes(1),
+            ng: lanes(2),
+            ns: lanes(3),
+            shape: U32x16::from_array(shape),
+            primitive: U32x16::from_array(primitive),
+        }
     }
 
     /// `occluded` for the rays of the lanes of `m`: the lanes whose segment is blocked

@@ -17,6 +17,8 @@
 
 use glam::Vec3;
 
+use crate::math::lanes::{Real, U32x16, V3};
+
 use super::offset::gamma;
 
 /// One triangle in the BVH's order, laid out for the test: `rows[k]` holds coordinate k of
@@ -430,9 +432,28 @@ pub fn intersect(tri: &TriangleRecord, r: &TriangleRay, t_max: f32) -> Option<Tr
 /// more. So |p̂ − p| ≤ γ(4)·Σ|b_i v_i| + γ(3)·Σ|b̂_i v_i| ≤ γ(8)·Σ|b̂_i v_i| per coordinate;
 /// γ(9) leaves room for replacing b by b̂ in the bound.
 pub fn hit_point(v: [Vec3; 3], b: [f32; 3]) -> (Vec3, Vec3) {
-    let p = v[0] * b[0] + v[1] * b[1] + v[2] * b[2];
-    let sum_abs = (v[0] * b[0]).abs() + (v[1] * b[1]).abs() + (v[2] * b[2]).abs();
-    (p, sum_abs * gamma(9))
+    let (p, p_error) = hit_point_in(v.map(V3::from), b);
+    (p.into(), p_error.into())
+}
+
+/// `hit_point` over `Real` (one hit, or sixteen in lanes).
+#[inline(always)]
+pub fn hit_point_in<T: Real>(v: [V3<T>; 3], b: [T; 3]) -> (V3<T>, V3<T>) {
+    let w = [v[0] * b[0], v[1] * b[1], v[2] * b[2]];
+    let p = w[0] + w[1] + w[2];
+    let sum_abs = w[0].abs() + w[1].abs() + w[2].abs();
+    (p, sum_abs * T::splat(gamma(9)))
+}
+
+/// The (shape, primitive) identity `TriangleRecord::new` stores in the fourth lanes of its
+/// rows, from those three lanes' bits (per lane).
+#[inline(always)]
+pub(super) fn ids_lanes(rows: [U32x16; 3]) -> (U32x16, U32x16) {
+    let payload = U32x16::splat(PAYLOAD);
+    let [r0, r1, r2] = rows.map(|r| r & payload);
+    let shape = r0 | (r2 & U32x16::splat(0x1ff)).shl::<23>();
+    let primitive = r1 | r2.shr::<9>().shl::<23>();
+    (shape, primitive)
 }
 
 #[cfg(test)]

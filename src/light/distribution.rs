@@ -14,6 +14,17 @@ use crate::math::lanes::{F32x16, F64x8, Mask16, U32x16};
 /// The largest f32 below one: sampled positions stay in [0, 1).
 const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
 
+/// `v.clamp(0.0, ONE_MINUS_EPSILON)` per lane.
+#[inline(always)]
+fn clamp_unit(v: F32x16) -> F32x16 {
+    let v = F32x16::select(v.lt(F32x16::splat(0.0)), F32x16::splat(0.0), v);
+    F32x16::select(
+        v.gt(F32x16::splat(ONE_MINUS_EPSILON)),
+        F32x16::splat(ONE_MINUS_EPSILON),
+        v,
+    )
+}
+
 /// Up to this many items `find` counts instead of searching.
 const SMALL: usize = 16;
 
@@ -123,43 +134,13 @@ impl Distribution1D {
     /// lane at a time by `sample_discrete` itself.
     #[inline]
     pub fn sample_discrete_lanes(&self, u: F32x16, m: Mask16) -> (U32x16, F32x16, F32x16) {
-        let n = self.func.len();
-        if n > LANE_ITEMS {
-            let u = u.to_array();
-            let (mut index, mut pmf, mut remapped) = ([0u32; 16], [0.0f32; 16], [0.0f32; 16]);
-            for i in m.lanes() {
-                let (k, p, r) = self.sample_discrete(u[i]);
-                (index[i], pmf[i], remapped[i]) = (k as u32, p, r);
-            }
-            return (
-                U32x16::from_array(index),
-                F32x16::from_array(pmf),
-                F32x16::from_array(remapped),
-            );
+        if self.func.len() > LANE_ITEMS {
+            return self.sample_discrete_one_by_one(u, m);
         }
-        let clamp = |v: F32x16| {
-            let v = F32x16::select(v.lt(F32x16::splat(0.0)), F32x16::splat(0.0), v);
-            F32x16::select(
-                v.gt(F32x16::splat(ONE_MINUS_EPSILON)),
-                F32x16::splat(ONE_MINUS_EPSILON),
-                v,
-            )
-        };
-        let (u_lo, u_hi) = clamp(u).to_f64_halves();
-        // `find`: the number of cdf entries <= u, minus one, at most n − 1.
-        let one = U32x16::splat(1);
-        let mut count = U32x16::splat(0);
-        for &c in &self.cdf {
-            let c = F64x8::splat(c);
-            let below = Mask16::from_halves(c.le(u_lo), c.le(u_hi));
-            count = count + U32x16::select(below, one, U32x16::splat(0));
-        }
-        let index = U32x16::select(count.eq(U32x16::splat(0)), count, count - one);
-        let last = U32x16::splat(n as u32 - 1);
-        let index = U32x16::select(last.lt(index), last, index);
+        let (index, u_lo, u_hi) = self.find_lanes(u);
         // cdf[index] and cdf[index + 1].
         let (mut lo, mut hi) = ([F64x8::splat(0.0); 2], [F64x8::splat(1.0); 2]);
-        for k in 0..n {
+        for k in 0..self.func.len() {
             let (at_lo, at_hi) = index.eq(U32x16::splat(k as u32)).halves();
             for (h, at) in [at_lo, at_hi].into_iter().enumerate() {
                 lo[h] = F64x8::select(at, F64x8::splat(self.cdf[k]), lo[h]);
@@ -181,8 +162,57 @@ impl Distribution1D {
         );
         let pmf = F32x16::gather(&self.pmf, index, m);
         let index = U32x16::select(m, index, U32x16::splat(0));
-        let remapped = F32x16::select(m, clamp(remapped), F32x16::splat(0.0));
+        let remapped = F32x16::select(m, clamp_unit(remapped), F32x16::splat(0.0));
         (index, pmf, remapped)
+    }
+
+    /// The item and its probability of `sample_discrete_lanes`, without the remapped `u`.
+    #[inline]
+    pub fn pick_lanes(&self, u: F32x16, m: Mask16) -> (U32x16, F32x16) {
+        if self.func.len() > LANE_ITEMS {
+            let (index, pmf, _) = self.sample_discrete_one_by_one(u, m);
+            return (index, pmf);
+        }
+        let index = if self.func.len() == 1 {
+            U32x16::splat(0)
+        } else {
+            self.find_lanes(u).0
+        };
+        let pmf = F32x16::gather(&self.pmf, index, m);
+        (U32x16::select(m, index, U32x16::splat(0)), pmf)
+    }
+
+    /// `find` per lane for `u` clamped as `sample_discrete` clamps it; with that `u` in f64
+    /// (lanes 0–7, 8–15).
+    #[inline(always)]
+    fn find_lanes(&self, u: F32x16) -> (U32x16, F64x8, F64x8) {
+        let (u_lo, u_hi) = clamp_unit(u).to_f64_halves();
+        // The number of cdf entries <= u, minus one, at most n − 1.
+        let one = U32x16::splat(1);
+        let mut count = U32x16::splat(0);
+        for &c in &self.cdf {
+            let c = F64x8::splat(c);
+            let below = Mask16::from_halves(c.le(u_lo), c.le(u_hi));
+            count = count + U32x16::select(below, one, U32x16::splat(0));
+        }
+        let index = U32x16::select(count.eq(U32x16::splat(0)), count, count - one);
+        let last = U32x16::splat(self.func.len() as u32 - 1);
+        (U32x16::select(last.lt(index), last, index), u_lo, u_hi)
+    }
+
+    /// `sample_discrete` lane after lane (for more than `LANE_ITEMS` items).
+    fn sample_discrete_one_by_one(&self, u: F32x16, m: Mask16) -> (U32x16, F32x16, F32x16) {
+        let u = u.to_array();
+        let (mut index, mut pmf, mut remapped) = ([0u32; 16], [0.0f32; 16], [0.0f32; 16]);
+        for i in m.lanes() {
+            let (k, p, r) = self.sample_discrete(u[i]);
+            (index[i], pmf[i], remapped[i]) = (k as u32, p, r);
+        }
+        (
+            U32x16::from_array(index),
+            F32x16::from_array(pmf),
+            F32x16::from_array(remapped),
+        )
     }
 
     /// Probability of item `i`.
@@ -326,6 +356,12 @@ mod tests {
                 });
                 let m = Mask16(0xffff ^ (1 << (round % 16)));
                 let (index, pmf, remapped) = d.sample_discrete_lanes(F32x16::from_array(u), m);
+                let picked = d.pick_lanes(F32x16::from_array(u), m);
+                assert_eq!(picked.0.to_array(), index.to_array());
+                assert_eq!(
+                    picked.1.to_array().map(f32::to_bits),
+                    pmf.to_array().map(f32::to_bits)
+                );
                 let (index, pmf, remapped) =
                     (index.to_array(), pmf.to_array(), remapped.to_array());
                 for i in 0..16 {

@@ -34,12 +34,11 @@ impl LightSelection {
         self.by_power.as_ref().map(|d| d.sample_discrete(u))
     }
 
-    /// `sample` for the lanes of `m` (`Distribution1D::sample_discrete_lanes`).
+    /// The light and its probability of `sample`, for the lanes of `m`
+    /// (`Distribution1D::pick_lanes`).
     #[inline]
-    pub fn sample_lanes(&self, u: F32x16, m: Mask16) -> Option<(U32x16, F32x16, F32x16)> {
-        self.by_power
-            .as_ref()
-            .map(|d| d.sample_discrete_lanes(u, m))
+    pub fn choose_lanes(&self, u: F32x16, m: Mask16) -> Option<(U32x16, F32x16)> {
+        self.by_power.as_ref().map(|d| d.pick_lanes(u, m))
     }
 
     /// Probability of choosing light `i`.

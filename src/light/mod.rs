@@ -610,11 +610,11 @@ impl LightSet {
         self.selection.sample(u)
     }
 
-    /// `sample` for the lanes of `m`: (index, probability, `u` rescaled) per lane; None
-    /// when there is no light to choose.
+    /// The light `sample` chooses and its probability, for the lanes of `m`; None when
+    /// there is no light to choose.
     #[inline]
-    pub fn sample_lanes(&self, u: F32x16, m: Mask16) -> Option<(U32x16, F32x16, F32x16)> {
-        self.selection.sample_lanes(u, m)
+    pub fn choose_lanes(&self, u: F32x16, m: Mask16) -> Option<(U32x16, F32x16)> {
+        self.selection.choose_lanes(u, m)
     }
 
     /// Probability that `sample` chooses light `i`.

@@ -61,7 +61,7 @@ impl NeeLanes {
             pmf: zero,
             delta: Mask16::NONE,
         };
-        let Some((index, pmf, _)) = scene.lights.sample_lanes(u_light, m) else {
+        let Some((index, pmf)) = scene.lights.choose_lanes(u_light, m) else {
             return out;
         };
         out.pmf = pmf;

@@ -181,7 +181,7 @@ impl PathSample {
         };
         for lane in (sees_environment | emitter).lanes() {
             let mut state = lanes.get(lane);
-            if !self.arrive(scene, &mut state, hits.interaction(lane)) {
+            if !self.arrive(scene, &mut state, hits.interaction(scene, lane).as_ref()) {
                 ended.set(lane, true);
             }
             lanes.put(lane, &state);
@@ -197,9 +197,9 @@ impl PathSample {
             let mut state = lanes.get(lane);
             let mut sampler = IndependentSampler::with_state(0, lanes.streams.lane(lane));
             let si = hits
-                .interaction(lane)
+                .interaction(scene, lane)
                 .expect("a lane that scatters has a hit");
-            if !self.scatter(scene, &mut state, si, &mut sampler) {
+            if !self.scatter(scene, &mut state, &si, &mut sampler) {
                 ended.set(lane, true);
             }
             lanes.put(lane, &state);
