@@ -360,16 +360,18 @@ pub struct ClosestLanes {
     found: Found,
 }
 
-/// How `ClosestLanes` found its hits.
+/// How `ClosestLanes` found its hits. Both kinds stay inline (a `ClosestLanes` lives on
+/// the stack of one round of the wavefront): boxing one would allocate per query.
+#[allow(clippy::large_enum_variant)]
 enum Found {
     /// By the sixteen-ray test: per lane the closest record and its hit (t in the scaled
     /// ray's units), and the scaled rays.
     Packet {
         best: BestLanes,
-        rays: Box<[ScaledRay; LANES]>,
+        rays: [ScaledRay; LANES],
     },
     /// By the per-ray query, lane after lane.
-    OneByOne(Box<[Option<ClosestHit>; LANES]>),
+    OneByOne([Option<ClosestHit>; LANES]),
 }
 
 impl ClosestLanes {
@@ -410,7 +412,7 @@ impl Geometry {
     /// time otherwise.
     pub fn closest_hits_lanes(&self, rays: &RayLanes, m: Mask16) -> ClosestLanes {
         if !self.bvh.is_flat() || self.has_analytic_shapes() {
-            let mut hits = Box::new([None; LANES]);
+            let mut hits = [None; LANES];
             for i in m.lanes() {
                 hits[i] = self.closest_hit(&rays.lane(i));
             }
@@ -422,7 +424,7 @@ impl Geometry {
         let scaled = ScaledRayLanes::new(rays);
         let m = m & scaled.valid;
         let tri = TriangleRayLanes::new(&scaled.o, &scaled.d);
-        let per_ray = Box::new(scaled.lanes());
+        let per_ray = scaled.lanes();
         let tri_ray = |i: usize| TriangleRay::new(per_ray[i].o, per_ray[i].d);
         let best = self
             .bvh
