@@ -579,11 +579,12 @@ impl Estimator for Bdpt {
                 out
             })
             .collect();
-        for r in &results {
+        for r in results {
             self.film.merge_tile(&r.tile);
             self.film.merge_splats(&r.splats);
             self.stats.rays += r.rays;
             self.stats.invalid_samples += r.invalid;
+            self.film.recycle(r.tile);
         }
         self.stats.passes += 1;
         self.stats.samples += self.film.width() as u64 * self.film.height() as u64;

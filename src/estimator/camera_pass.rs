@@ -128,8 +128,9 @@ pub fn camera_pass(
         .map(|batch| estimate.render_tiles(&pass, batch))
         .collect();
     let mut total = PassCounts::default();
-    for (tile, counts) in finished.iter().flatten() {
-        film.merge_tile(tile);
+    for (tile, counts) in finished.into_iter().flatten() {
+        film.merge_tile(&tile);
+        film.recycle(tile);
         total.samples += counts.samples;
         total.rays += counts.rays;
         total.invalid += counts.invalid;

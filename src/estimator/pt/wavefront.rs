@@ -12,6 +12,8 @@
 //! built-in scene); the wavefront changes only the speed. What the lane code does not
 //! cover is done by the scalar code for that lane (`PathSample::arrive` / `scatter`).
 
+use std::cell::RefCell;
+
 use glam::Vec2;
 
 use super::PathSample;
@@ -45,16 +47,43 @@ impl PathSample {
         pass: &PassContext,
         rects: &[PixelRect],
     ) -> Vec<(FilmTile, PassCounts)> {
-        let mut queue: Vec<QueuedSample> = rects
-            .iter()
-            .flat_map(|r| (r.y0..r.y1).flat_map(move |y| (r.x0..r.x1).map(move |x| (x, y))))
-            .map(|pixel| QueuedSample {
-                pixel,
-                raster: Vec2::ZERO,
-                value: Rgb::BLACK,
-                rays: 0,
-            })
-            .collect();
+        // Each worker thread keeps its queue from batch to batch (no allocation per batch).
+        thread_local! {
+            static QUEUE: RefCell<Vec<QueuedSample>> = const { RefCell::new(Vec::new()) };
+        }
+        QUEUE.with_borrow_mut(|queue| {
+            queue.clear();
+            queue.extend(
+                rects
+                    .iter()
+                    .flat_map(|r| (r.y0..r.y1).flat_map(move |y| (r.x0..r.x1).map(move |x| (x, y))))
+                    .map(|pixel| QueuedSample {
+                        pixel,
+                        raster: Vec2::ZERO,
+                        value: Rgb::BLACK,
+                        rays: 0,
+                    }),
+            );
+            self.trace_queue(pass, queue);
+            // Finished samples go to their tiles in queue order, as `render_tile` adds them.
+            let mut samples = queue.iter();
+            rects
+                .iter()
+                .map(|&rect| {
+                    let mut tile = pass.film.tile(rect);
+                    let mut counts = PassCounts::default();
+                    let n = ((rect.x1 - rect.x0) * (rect.y1 - rect.y0)) as usize;
+                    for q in samples.by_ref().take(n) {
+                        counts.add_sample(&mut tile, q.raster, q.value, q.rays);
+                    }
+                    (tile, counts)
+                })
+                .collect()
+        })
+    }
+
+    /// Traces every camera sample of `queue` in lanes, filling in its result.
+    fn trace_queue(&self, pass: &PassContext, queue: &mut [QueuedSample]) {
         let mut lanes = PathLanes::default();
         let mut next = 0usize;
         let mut sampler = pass.camera_sampler();
@@ -65,7 +94,7 @@ impl PathSample {
             && self.max_depth() > 0;
         loop {
             if start_in_lanes {
-                next = self.start_in_lanes(pass, &mut lanes, &mut queue, next);
+                next = self.start_in_lanes(pass, &mut lanes, queue, next);
             }
             // Empty lanes take the next camera samples.
             for lane in (!lanes.live).lanes() {
@@ -92,22 +121,8 @@ impl PathSample {
             if lanes.live.none() {
                 break;
             }
-            self.advance_lanes(pass, &mut lanes, &mut queue);
+            self.advance_lanes(pass, &mut lanes, queue);
         }
-        // Finished samples go to their tiles in queue order, as `render_tile` adds them.
-        let mut samples = queue.iter();
-        rects
-            .iter()
-            .map(|&rect| {
-                let mut tile = pass.film.tile(rect);
-                let mut counts = PassCounts::default();
-                let n = ((rect.x1 - rect.x0) * (rect.y1 - rect.y0)) as usize;
-                for q in samples.by_ref().take(n) {
-                    counts.add_sample(&mut tile, q.raster, q.value, q.rays);
-                }
-                (tile, counts)
-            })
-            .collect()
     }
 
     /// Empty lanes take the next camera samples of `queue` (from index `next`), started in
