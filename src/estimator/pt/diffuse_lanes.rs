@@ -7,6 +7,7 @@ use super::PathSample;
 use super::hit_lanes::HitLanes;
 use super::lane_scene::LaneScene;
 use super::path_lanes::{PathLanes, lane, lane3, put3, with_lane};
+use super::shadow_queue::ShadowQueue;
 use crate::geometry::SHADOW_EPSILON;
 use crate::geometry::offset::offset_origin;
 use crate::geometry::packet::RayLanes;
@@ -150,6 +151,7 @@ impl PathSample {
         lanes: &mut PathLanes,
         hits: &HitLanes,
         m: Mask16,
+        shadows: &mut ShadowQueue,
     ) -> Mask16 {
         let zero = F32x16::splat(0.0);
         let zero3 = V3::new(zero, zero, zero);
@@ -185,12 +187,6 @@ impl PathSample {
             F32x16::splat(1.0 - SHADOW_EPSILON),
             F32x16::splat(f32::INFINITY),
         );
-        let shadow = RayLanes {
-            o: origin,
-            d: dir,
-            t_max,
-        };
-        let lit = shoot & !scene.geometry.occluded_lanes(&shadow, shoot);
         lanes.rays = lanes.rays + U32x16::select(shoot, U32x16::splat(1), U32x16::splat(0));
         let pdf_light = ls.pmf * ls.pdf_solid_angle;
         // Diffuse::pdf: the cosine density where wo is above the surface.
@@ -202,13 +198,30 @@ impl PathSample {
         let weight = F32x16::select(
             ls.delta,
             F32x16::splat(1.0),
-            power_heuristic_lanes(pdf_light, bsdf_pdf, lit & !ls.delta),
+            power_heuristic_lanes(pdf_light, bsdf_pdf, shoot & !ls.delta),
         );
-        let contribution = V3::select(lit, f.mul_v(ls.radiance) * (weight / pdf_light), zero3);
-        lanes.result = V3::select(
-            m,
-            lanes.result + lanes.throughput.mul_v(contribution),
-            lanes.result,
+        // What each lane adds: throughput × contribution if its shadow ray is unoccluded,
+        // throughput × black otherwise (and without a shadow ray). The latter is +0, which
+        // changes no sum, unless the throughput is not finite: those lanes queue it too,
+        // with a shadow ray of no length (never occluded), so that it is added in order.
+        let contribution = f.mul_v(ls.radiance) * (weight / pdf_light);
+        let lit = lanes.throughput.mul_v(contribution);
+        let dark = lanes.throughput.mul_v(zero3);
+        let signed_zero = |v: F32x16| v.to_bits().eq(U32x16::splat(0));
+        let no_op = signed_zero(dark.x) & signed_zero(dark.y) & signed_zero(dark.z);
+        let odd = m & !shoot & !no_op;
+        let queued = shoot | odd;
+        let shadow = RayLanes {
+            o: origin,
+            d: dir,
+            t_max: F32x16::select(shoot, t_max, zero),
+        };
+        shadows.push(
+            queued,
+            &shadow,
+            &V3::select(shoot, lit, dark),
+            &dark,
+            U32x16::from_array(lanes.sample),
         );
 
         // BSDF sampling (`Diffuse::sample`): the next segment.

@@ -26,6 +26,7 @@ mod diffuse_lanes;
 mod hit_lanes;
 mod lane_scene;
 mod path_lanes;
+mod shadow_queue;
 mod wavefront;
 
 use super::camera_pass::{CameraEstimator, CameraSampleFn, PassContext, PassCounts, render_tile};

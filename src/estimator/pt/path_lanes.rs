@@ -47,8 +47,6 @@ pub(super) struct PathLanes {
     pub origin: V3<F32x16>,
     pub direction: V3<F32x16>,
     pub t_max: F32x16,
-    /// Radiance found so far (r, g, b).
-    pub result: V3<F32x16>,
     /// Throughput (r, g, b).
     pub throughput: V3<F32x16>,
     pub eta: F32x16,
@@ -76,7 +74,6 @@ impl Default for PathLanes {
             origin: zero3,
             direction: zero3,
             t_max: zero,
-            result: zero3,
             throughput: zero3,
             eta: zero,
             prev_p: zero3,
@@ -95,12 +92,10 @@ impl PathLanes {
     /// Lanes `m` start paths along camera rays `rays` (as `PathSample::start`), emitters
     /// and the environment shown to the camera unless `hide_emitters`.
     pub fn start(&mut self, m: Mask16, rays: &RayLanes, hide_emitters: bool) {
-        let zero = F32x16::splat(0.0);
         let one = F32x16::splat(1.0);
         self.origin = V3::select(m, rays.o, self.origin);
         self.direction = V3::select(m, rays.d, self.direction);
         self.t_max = F32x16::select(m, rays.t_max, self.t_max);
-        self.result = V3::select(m, V3::new(zero, zero, zero), self.result);
         self.throughput = V3::select(m, V3::new(one, one, one), self.throughput);
         self.eta = F32x16::select(m, one, self.eta);
         self.prev_p = V3::select(m, rays.o, self.prev_p);
@@ -118,7 +113,8 @@ impl PathLanes {
         self.live |= m;
     }
 
-    /// The path in lane `i`.
+    /// The path in lane `i`. Its radiance so far is its sample's (`wavefront.rs`): here
+    /// black.
     pub fn get(&self, i: usize) -> PathState {
         let rgb = |v: &V3<F32x16>| {
             let c = lane3(v, i);
@@ -130,7 +126,7 @@ impl PathLanes {
                 d: lane3(&self.direction, i),
                 t_max: lane(self.t_max, i),
             },
-            result: rgb(&self.result),
+            result: Rgb::BLACK,
             throughput: rgb(&self.throughput),
             eta: lane(self.eta, i),
             prev: PreviousVertex {
@@ -145,13 +141,13 @@ impl PathLanes {
         }
     }
 
-    /// Lane `i` holds path `state` from now on.
+    /// Lane `i` holds path `state` from now on (all but its radiance so far, which its
+    /// sample keeps).
     pub fn put(&mut self, i: usize, state: &PathState) {
         let rgb = |c: Rgb| Vec3::new(c.r(), c.g(), c.b());
         put3(&mut self.origin, i, state.ray.o);
         put3(&mut self.direction, i, state.ray.d);
         self.t_max = with_lane(self.t_max, i, state.ray.t_max);
-        put3(&mut self.result, i, rgb(state.result));
         put3(&mut self.throughput, i, rgb(state.throughput));
         self.eta = with_lane(self.eta, i, state.eta);
         self.shows_emitters.set(i, state.prev.shows_emitters);

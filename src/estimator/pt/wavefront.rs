@@ -17,9 +17,11 @@ use std::cell::RefCell;
 use glam::Vec2;
 
 use super::PathSample;
+use super::PathState;
 use super::hit_lanes::HitLanes;
 use super::lane_scene::NO_LIGHT;
 use super::path_lanes::PathLanes;
+use super::shadow_queue::ShadowQueue;
 use crate::camera::raster_in_pixel_lanes;
 use crate::estimator::camera_pass::{PassContext, PassCounts, start_camera_sample};
 use crate::film::{FilmTile, PixelRect};
@@ -27,16 +29,18 @@ use crate::math::Rgb;
 use crate::math::lanes::{LANES, Mask16, U32x16};
 use crate::sampler::IndependentSampler;
 use crate::sampler::pixel_samples::PixelSamples;
+use crate::scene::Scene;
 
 /// Tiles of 16×16 pixels per task: 1024 paths keep the lanes full for most of a batch.
 pub(super) const TILES_PER_TASK: usize = 4;
 
-/// One camera sample of a batch: where it is and, once traced, what it found.
+/// One camera sample of a batch: where it is, the radiance its path has found so far, and
+/// the rays it cast.
 #[derive(Clone, Copy)]
-struct QueuedSample {
+pub(super) struct QueuedSample {
     pixel: (u32, u32),
     raster: Vec2,
-    value: Rgb,
+    pub value: Rgb,
     rays: u64,
 }
 
@@ -50,40 +54,51 @@ impl PathSample {
         // Each worker thread keeps its queue from batch to batch (no allocation per batch).
         thread_local! {
             static QUEUE: RefCell<Vec<QueuedSample>> = const { RefCell::new(Vec::new()) };
+            static SHADOWS: RefCell<ShadowQueue> = RefCell::new(ShadowQueue::default());
         }
         QUEUE.with_borrow_mut(|queue| {
-            queue.clear();
-            queue.extend(
+            SHADOWS.with_borrow_mut(|shadows| {
+                queue.clear();
+                queue.extend(
+                    rects
+                        .iter()
+                        .flat_map(|r| {
+                            (r.y0..r.y1).flat_map(move |y| (r.x0..r.x1).map(move |x| (x, y)))
+                        })
+                        .map(|pixel| QueuedSample {
+                            pixel,
+                            raster: Vec2::ZERO,
+                            value: Rgb::BLACK,
+                            rays: 0,
+                        }),
+                );
+                self.trace_queue(pass, queue, shadows);
+                // Finished samples go to their tiles in queue order, as `render_tile` adds them.
+                let mut samples = queue.iter();
                 rects
                     .iter()
-                    .flat_map(|r| (r.y0..r.y1).flat_map(move |y| (r.x0..r.x1).map(move |x| (x, y))))
-                    .map(|pixel| QueuedSample {
-                        pixel,
-                        raster: Vec2::ZERO,
-                        value: Rgb::BLACK,
-                        rays: 0,
-                    }),
-            );
-            self.trace_queue(pass, queue);
-            // Finished samples go to their tiles in queue order, as `render_tile` adds them.
-            let mut samples = queue.iter();
-            rects
-                .iter()
-                .map(|&rect| {
-                    let mut tile = pass.film.tile(rect);
-                    let mut counts = PassCounts::default();
-                    let n = ((rect.x1 - rect.x0) * (rect.y1 - rect.y0)) as usize;
-                    for q in samples.by_ref().take(n) {
-                        counts.add_sample(&mut tile, q.raster, q.value, q.rays);
-                    }
-                    (tile, counts)
-                })
-                .collect()
+                    .map(|&rect| {
+                        let mut tile = pass.film.tile(rect);
+                        let mut counts = PassCounts::default();
+                        let n = ((rect.x1 - rect.x0) * (rect.y1 - rect.y0)) as usize;
+                        for q in samples.by_ref().take(n) {
+                            counts.add_sample(&mut tile, q.raster, q.value, q.rays);
+                        }
+                        (tile, counts)
+                    })
+                    .collect()
+            })
         })
     }
 
     /// Traces every camera sample of `queue` in lanes, filling in its result.
-    fn trace_queue(&self, pass: &PassContext, queue: &mut [QueuedSample]) {
+    fn trace_queue(
+        &self,
+        pass: &PassContext,
+        queue: &mut [QueuedSample],
+        shadows: &mut ShadowQueue,
+    ) {
+        debug_assert!(shadows.is_empty());
         let mut lanes = PathLanes::default();
         let mut next = 0usize;
         let mut sampler = pass.camera_sampler();
@@ -121,8 +136,9 @@ impl PathSample {
             if lanes.live.none() {
                 break;
             }
-            self.advance_lanes(pass, &mut lanes, queue);
+            self.advance_lanes(pass, &mut lanes, queue, shadows);
         }
+        shadows.flush(&pass.scene.geometry, queue);
     }
 
     /// Empty lanes take the next camera samples of `queue` (from index `next`), started in
@@ -167,8 +183,42 @@ impl PathSample {
         next
     }
 
+    /// Lane `lane`'s path for the scalar code, with its sample's radiance so far (its
+    /// queued shadow rays resolved first, so that what the scalar code adds comes after).
+    fn take_path(
+        &self,
+        scene: &Scene,
+        lanes: &PathLanes,
+        lane: usize,
+        queue: &mut [QueuedSample],
+        shadows: &mut ShadowQueue,
+    ) -> PathState {
+        let sample = lanes.sample[lane];
+        shadows.resolve(sample, &scene.geometry, queue);
+        let mut state = lanes.get(lane);
+        state.result = queue[sample as usize].value;
+        state
+    }
+
+    /// Puts back a path `take_path` took, after the scalar code advanced it.
+    fn give_back(
+        lanes: &mut PathLanes,
+        lane: usize,
+        state: &PathState,
+        queue: &mut [QueuedSample],
+    ) {
+        queue[lanes.sample[lane] as usize].value = state.result;
+        lanes.put(lane, state);
+    }
+
     /// Advances every live lane by one vertex; lanes whose path ends write it to `queue`.
-    fn advance_lanes(&self, pass: &PassContext, lanes: &mut PathLanes, queue: &mut [QueuedSample]) {
+    fn advance_lanes(
+        &self,
+        pass: &PassContext,
+        lanes: &mut PathLanes,
+        queue: &mut [QueuedSample],
+        shadows: &mut ShadowQueue,
+    ) {
         let scene = pass.scene;
         let tables = self
             .lane_scene
@@ -195,11 +245,11 @@ impl PathSample {
             escaped & lanes.shows_environment
         };
         for lane in (sees_environment | emitter).lanes() {
-            let mut state = lanes.get(lane);
+            let mut state = self.take_path(scene, lanes, lane, queue, shadows);
             if !self.arrive(scene, &mut state, hits.interaction(scene, lane).as_ref()) {
                 ended.set(lane, true);
             }
-            lanes.put(lane, &state);
+            Self::give_back(lanes, lane, &state, queue);
         }
         let deep = !(lanes.depth + one).lt(U32x16::splat(self.max_depth()));
         ended |= hits.hit & !emitter & deep;
@@ -207,9 +257,10 @@ impl PathSample {
         // Scattering: diffuse surfaces in lanes, the others one by one.
         let going = live & !ended;
         let diffuse = going & U32x16::gather(&tables.diffuse, hits.shape, going).eq(one);
-        ended |= self.scatter_diffuse(scene, tables, lanes, &hits, diffuse);
+        ended |= self.scatter_diffuse(scene, tables, lanes, &hits, diffuse, shadows);
+        shadows.cast_full(&scene.geometry, queue);
         for lane in (going & !diffuse).lanes() {
-            let mut state = lanes.get(lane);
+            let mut state = self.take_path(scene, lanes, lane, queue, shadows);
             let mut sampler = IndependentSampler::with_state(0, lanes.streams.lane(lane));
             let si = hits
                 .interaction(scene, lane)
@@ -217,21 +268,15 @@ impl PathSample {
             if !self.scatter(scene, &mut state, &si, &mut sampler) {
                 ended.set(lane, true);
             }
-            lanes.put(lane, &state);
+            Self::give_back(lanes, lane, &state, queue);
             lanes.streams.set_lane(lane, sampler.state());
         }
 
-        // Finished paths go to the queue.
-        let (r, g, b) = (
-            lanes.result.x.to_array(),
-            lanes.result.y.to_array(),
-            lanes.result.z.to_array(),
-        );
+        // Finished paths leave their lanes (their samples hold their radiance; shadow rays
+        // still queued add to it later).
         let rays = lanes.rays.to_array();
         for lane in ended.lanes() {
-            let q = &mut queue[lanes.sample[lane] as usize];
-            q.value = Rgb::new(r[lane], g[lane], b[lane]);
-            q.rays = rays[lane] as u64;
+            queue[lanes.sample[lane] as usize].rays = rays[lane] as u64;
         }
         lanes.live = live & !ended;
     }

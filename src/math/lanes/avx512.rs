@@ -218,6 +218,14 @@ impl F32x16 {
         })
     }
 
+    /// Stores the lanes of `m`, in lane order, at the start of `dst` (which must have room
+    /// for sixteen).
+    #[inline(always)]
+    pub fn compress_store(self, m: Mask16, dst: &mut [f32]) {
+        assert!(dst.len() >= 16);
+        unsafe { _mm512_mask_compressstoreu_ps(dst.as_mut_ptr(), m.0, self.0) };
+    }
+
     /// Lane i of the result is lane `idx[i] mod 16` of `self`.
     #[inline(always)]
     pub fn permute(self, idx: U32x16) -> F32x16 {
@@ -272,6 +280,14 @@ impl U32x16 {
     #[inline(always)]
     pub fn shr<const N: u32>(self) -> U32x16 {
         U32x16(unsafe { _mm512_srli_epi32::<N>(self.0) })
+    }
+
+    /// Stores the lanes of `m`, in lane order, at the start of `dst` (which must have room
+    /// for sixteen).
+    #[inline(always)]
+    pub fn compress_store(self, m: Mask16, dst: &mut [u32]) {
+        assert!(dst.len() >= 16);
+        unsafe { _mm512_mask_compressstoreu_epi32(dst.as_mut_ptr() as *mut i32, m.0, self.0) };
     }
 
     /// Unsigned minimum.

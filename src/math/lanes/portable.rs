@@ -203,6 +203,16 @@ impl F32x16 {
         }))
     }
 
+    /// Stores the lanes of `m`, in lane order, at the start of `dst` (which must have room
+    /// for sixteen).
+    #[inline(always)]
+    pub fn compress_store(self, m: Mask16, dst: &mut [f32]) {
+        assert!(dst.len() >= 16);
+        for (k, i) in m.lanes().enumerate() {
+            dst[k] = self.0[i];
+        }
+    }
+
     /// Lane i of the result is lane `idx[i] mod 16` of `self`.
     #[inline(always)]
     pub fn permute(self, idx: U32x16) -> F32x16 {
@@ -255,6 +265,16 @@ impl U32x16 {
     #[inline(always)]
     pub fn shr<const N: u32>(self) -> U32x16 {
         U32x16(self.0.map(|a| a >> N))
+    }
+
+    /// Stores the lanes of `m`, in lane order, at the start of `dst` (which must have room
+    /// for sixteen).
+    #[inline(always)]
+    pub fn compress_store(self, m: Mask16, dst: &mut [u32]) {
+        assert!(dst.len() >= 16);
+        for (k, i) in m.lanes().enumerate() {
+            dst[k] = self.0[i];
+        }
     }
 
     /// Unsigned minimum.

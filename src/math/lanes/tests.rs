@@ -241,6 +241,14 @@ fn integer_lane_operations_equal_scalar_ones() {
         let wide: Vec<u64> = lo.to_array().into_iter().chain(hi.to_array()).collect();
         assert_eq!(wide, a.map(|v| v as u64).to_vec());
         assert_eq!(x.max(y).to_array(), std::array::from_fn(|i| a[i].max(b[i])));
+        let m = Mask16(a[0] as u16);
+        let (mut packed, mut packed_int) = ([f32::NAN; 20], [7u32; 20]);
+        F32x16::from_array(std::array::from_fn(|i| i as f32)).compress_store(m, &mut packed);
+        x.compress_store(m, &mut packed_int);
+        for (k, i) in m.lanes().enumerate() {
+            assert_eq!((packed[k], packed_int[k]), (i as f32, a[i]));
+        }
+        assert!(packed[m.count() as usize].is_nan() && packed_int[m.count() as usize] == 7);
         let f = F32x16::from_array(std::array::from_fn(|i| i as f32 * 0.5));
         let p = f.permute(x).to_array();
         for i in 0..16 {
