@@ -101,18 +101,16 @@ impl ShadowQueue {
     pub fn resolve(&mut self, sample: u32, geometry: &Geometry, queue: &mut [QueuedSample]) {
         // Move the sample's entries to the front, keeping both groups' order, then cast.
         let mut order = [0usize; CAPACITY];
+        let entries = 0..self.len;
+        let theirs = entries.clone().filter(|&i| self.sample[i] == sample);
+        let others = entries.filter(|&i| self.sample[i] != sample);
         let mut mine = 0;
-        for i in (0..self.len).filter(|&i| self.sample[i] == sample) {
-            order[mine] = i;
-            mine += 1;
+        for (k, i) in theirs.chain(others).enumerate() {
+            order[k] = i;
+            mine += (self.sample[i] == sample) as usize;
         }
         if mine == 0 {
             return;
-        }
-        let mut k = mine;
-        for i in (0..self.len).filter(|&i| self.sample[i] != sample) {
-            order[k] = i;
-            k += 1;
         }
         self.reorder(&order[..self.len]);
         while mine > 0 {
