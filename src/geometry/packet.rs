@@ -192,42 +192,70 @@ impl TriangleRayLanes {
     }
 }
 
-/// What the lanes computed for one triangle (see `lane_tests`).
-struct LaneTests {
+/// One triangle in the ray space of each lane: the sheared vertex coordinates and the
+/// edge functions, exactly as `triangle::intersect_scalar` computes them.
+struct Sheared {
+    x: [F32x16; 3],
+    y: [F32x16; 3],
+    z: [F32x16; 3],
     e: [F32x16; 3],
-    det: F32x16,
-    /// t = T/det, meaningful in `settled` lanes.
-    t: F32x16,
-    /// Lanes that may pass the test within (0, t_max): the others certainly fail it.
-    candidate: Mask16,
-    /// Candidates decided here (no zero edge function, T above its error bound): they hit
-    /// at `t` if t < t_max. The other candidates need `triangle::intersect`.
-    settled: Mask16,
 }
 
-/// The watertight test of `tri` against the lanes of `m`, within (0, t_max) per lane.
+/// `Sheared` for the triangle whose coordinate `coord(k, j)` (k = 0, 1, 2 for the lane's
+/// kx, ky, kz axis; vertex j) each lane reads.
 #[inline(always)]
-fn lane_tests(tri: &PacketTriangle, r: &TriangleRayLanes, t_max: F32x16, m: Mask16) -> LaneTests {
-    let v = F32x16::from_array(*tri);
-    // Sheared vertex coordinates, as `triangle::intersect_scalar`.
+fn shear(r: &TriangleRayLanes, coord: impl Fn(usize, usize) -> F32x16) -> Sheared {
     let vertex = |j: usize| {
-        let [ix, iy, iz] = r.index[j];
-        let z = v.permute(iz) - r.oz;
-        let x = (v.permute(ix) - r.ox) - r.sx * z;
-        let y = (v.permute(iy) - r.oy) - r.sy * z;
+        let z = coord(2, j) - r.oz;
+        let x = (coord(0, j) - r.ox) - r.sx * z;
+        let y = (coord(1, j) - r.oy) - r.sy * z;
         (x, y, z)
     };
     let (x0, y0, z0) = vertex(0);
     let (x1, y1, z1) = vertex(1);
     let (x2, y2, z2) = vertex(2);
-    let e0 = x2 * y1 - y2 * x1;
-    let e1 = x0 * y2 - y0 * x2;
-    let e2 = x1 * y0 - y1 * x0;
+    Sheared {
+        e: [x2 * y1 - y2 * x1, x0 * y2 - y0 * x2, x1 * y0 - y1 * x0],
+        x: [x0, x1, x2],
+        y: [y0, y1, y2],
+        z: [z0, z1, z2],
+    }
+}
+
+impl Sheared {
+    /// (e0 + e1) + e2, as the per-triangle test sums it.
+    #[inline(always)]
+    fn det(&self) -> F32x16 {
+        (self.e[0] + self.e[1]) + self.e[2]
+    }
+}
+
+/// What the lanes computed for one triangle (see `lane_tests`).
+struct LaneTests {
+    sheared: Sheared,
+    /// T and det made positive (both negated where det < 0).
+    t_num_p: F32x16,
+    det_p: F32x16,
+    /// Lanes that may pass the test within (0, t_max): the others certainly fail it.
+    candidate: Mask16,
+    /// Candidates without a zero edge function and with 0 < t < t_max: they pass unless
+    /// T is within its rounding error bound of zero (`settled`).
+    in_range: Mask16,
+}
+
+/// The watertight test of `tri` against the lanes of `m`, within (0, t_max) per lane, up to
+/// the error bound of T (`settled`).
+#[inline(always)]
+fn lane_tests(tri: &PacketTriangle, r: &TriangleRayLanes, t_max: F32x16, m: Mask16) -> LaneTests {
+    let v = F32x16::from_array(*tri);
+    let sheared = shear(r, |k, j| v.permute(r.index[j][k]));
+    let [e0, e1, e2] = sheared.e;
+    let [z0, z1, z2] = sheared.z;
     let zero = F32x16::splat(0.0);
     let any_neg = e0.lt(zero) | e1.lt(zero) | e2.lt(zero);
     let any_pos = e0.gt(zero) | e1.gt(zero) | e2.gt(zero);
     let all_nonzero = e0.ne(zero) & e1.ne(zero) & e2.ne(zero);
-    let det = (e0 + e1) + e2;
+    let det = sheared.det();
     let t_num = (e0 * (z0 * r.sz) + e1 * (z1 * r.sz)) + e2 * (z2 * r.sz);
     // t = T/det with both made positive, as `triangle::hit_from`.
     let flip = det.lt(zero);
@@ -235,53 +263,65 @@ fn lane_tests(tri: &PacketTriangle, r: &TriangleRayLanes, t_max: F32x16, m: Mask
     let det_p = F32x16::select(flip, -det, det);
     let in_range = t_num_p.gt(zero) & t_num_p.lt(t_max * det_p);
     let candidate = m & !(any_neg & any_pos) & (!all_nonzero | in_range);
-    let mut out = LaneTests {
-        e: [e0, e1, e2],
-        det,
-        t: zero,
+    LaneTests {
+        sheared,
+        t_num_p,
+        det_p,
         candidate,
-        settled: Mask16::NONE,
-    };
-    if candidate.none() {
-        return out;
+        in_range: candidate & all_nonzero & in_range,
     }
-    // T's error bound from the largest |x|, |y|, |z| and |e|, as the per-triangle test.
-    let max3 = |a: F32x16, b: F32x16, c: F32x16| a.abs().max_gt(b.abs()).max_gt(c.abs());
-    let bound = triangle::t_num_error_bound_in(
-        max3(x0, x1, x2).max_gt(max3(y0, y1, y2)),
-        max3(z0, z1, z2),
-        max3(e0, e1, e2),
-        r.sz.abs(),
-    );
-    out.settled = candidate
-        & all_nonzero
-        & in_range
-        & bound.lt(t_num_p)
-        & bound.lt(F32x16::splat(f32::INFINITY));
-    out.t = t_num_p / det_p;
-    out
 }
 
-/// The closest hit found so far in each lane.
+impl LaneTests {
+    /// The lanes of `m` (within `in_range`) whose T exceeds its rounding error bound: their
+    /// t > 0 is certain, so they hit as the per-triangle test decides it without the f64
+    /// sign test. The bound from the largest |x|, |y|, |z| and |e|, as that test computes it.
+    #[inline(always)]
+    fn settled(&self, m: Mask16, r: &TriangleRayLanes) -> Mask16 {
+        let s = &self.sheared;
+        let max3 = |v: &[F32x16; 3]| v[0].abs().max_gt(v[1].abs()).max_gt(v[2].abs());
+        let bound = triangle::t_num_error_bound_in(
+            max3(&s.x).max_gt(max3(&s.y)),
+            max3(&s.z),
+            max3(&s.e),
+            r.sz.abs(),
+        );
+        m & bound.lt(self.t_num_p) & bound.lt(F32x16::splat(f32::INFINITY))
+    }
+
+    /// t = T/det (meaningful in `in_range` lanes).
+    #[inline(always)]
+    fn t(&self) -> F32x16 {
+        self.t_num_p / self.det_p
+    }
+}
+
+/// The closest hit found so far in each lane: its t and record. The edge functions of a
+/// hit settled in lanes are recomputed once at the end (`edges_of_best`); those of a hit
+/// that `triangle::intersect` decided (it may have recomputed them in f64) are kept here.
 struct BestLanes {
     t: F32x16,
     record: U32x16,
+    hit: Mask16,
+    /// Lanes whose hit `triangle::intersect` decided, with its edge functions and det.
+    scalar: Mask16,
+    scalar_e: [[f32; 3]; LANES],
+    scalar_det: [f32; LANES],
+    /// Filled in by `edges_of_best` for every hit lane.
     e: [F32x16; 3],
     det: F32x16,
-    hit: Mask16,
 }
 
 impl BestLanes {
-    /// Takes `h` (on record `k`) as lane `i`'s closest hit.
+    /// Takes `h` (on record `k`, decided by `triangle::intersect`) as lane `i`'s closest hit.
     fn set(&mut self, i: usize, k: u32, h: &TriangleHit) {
         let m = Mask16(1 << i);
         self.t = F32x16::select(m, F32x16::splat(h.t), self.t);
         self.record = U32x16::select(m, U32x16::splat(k), self.record);
-        for (e, &v) in self.e.iter_mut().zip(&h.e) {
-            *e = F32x16::select(m, F32x16::splat(v), *e);
-        }
-        self.det = F32x16::select(m, F32x16::splat(h.det), self.det);
         self.hit |= m;
+        self.scalar |= m;
+        self.scalar_e[i] = h.e;
+        self.scalar_det[i] = h.det;
     }
 }
 
@@ -301,28 +341,61 @@ impl PacketTriangles {
         let mut best = BestLanes {
             t: t_max,
             record: U32x16::splat(0),
+            hit: Mask16::NONE,
+            scalar: Mask16::NONE,
+            scalar_e: [[0.0; 3]; LANES],
+            scalar_det: [0.0; LANES],
             e: [zero; 3],
             det: zero,
-            hit: Mask16::NONE,
         };
         for (k, tri) in self.triangles.iter().enumerate() {
             let lanes = lane_tests(tri, r, best.t, m);
-            let closer = lanes.settled & lanes.t.lt(best.t);
-            best.t = F32x16::select(closer, lanes.t, best.t);
-            best.record = U32x16::select(closer, U32x16::splat(k as u32), best.record);
-            for (b, e) in best.e.iter_mut().zip(lanes.e) {
-                *b = F32x16::select(closer, e, *b);
+            if lanes.candidate.none() {
+                continue;
             }
-            best.det = F32x16::select(closer, lanes.det, best.det);
-            best.hit |= closer;
-            for i in (lanes.candidate & !lanes.settled).lanes() {
+            // Only a lane that would take this hit as its closest needs the error bound; a
+            // farther one is rejected by the per-triangle test's final t < t_max anyway.
+            let t = lanes.t();
+            let closer = lanes.in_range & t.lt(best.t);
+            let settled = if closer.any() {
+                lanes.settled(closer, r)
+            } else {
+                Mask16::NONE
+            };
+            best.t = F32x16::select(settled, t, best.t);
+            best.record = U32x16::select(settled, U32x16::splat(k as u32), best.record);
+            best.hit |= settled;
+            best.scalar &= !settled;
+            for i in ((lanes.candidate & !lanes.in_range) | (closer & !settled)).lanes() {
                 let t_max_i = best.t.to_array()[i];
                 if let Some(h) = triangle::intersect(&records[k], &tri_ray(i), t_max_i) {
                     best.set(i, k as u32, &h);
                 }
             }
         }
+        self.edges_of_best(&mut best, r);
         best
+    }
+
+    /// The edge functions and det of each lane's closest hit: recomputed from its record
+    /// with the same arithmetic for hits settled in lanes, kept for the others.
+    #[inline(always)]
+    fn edges_of_best(&self, best: &mut BestLanes, r: &TriangleRayLanes) {
+        let m = best.hit & !best.scalar;
+        if m.any() {
+            let table = self.triangles.as_flattened();
+            let base = best.record.shl::<4>();
+            let sheared = shear(r, |k, j| F32x16::gather(table, base + r.index[j][k], m));
+            best.det = sheared.det();
+            best.e = sheared.e;
+        }
+        for i in best.scalar.lanes() {
+            let m = Mask16(1 << i);
+            for (e, v) in best.e.iter_mut().zip(best.scalar_e[i]) {
+                *e = F32x16::select(m, F32x16::splat(v), *e);
+            }
+            best.det = F32x16::select(m, F32x16::splat(best.scalar_det[i]), best.det);
+        }
     }
 
     /// The lanes of `m` for which some record lies at 0 < t < t_max.
@@ -341,8 +414,12 @@ impl PacketTriangles {
                 break;
             }
             let lanes = lane_tests(tri, r, t_max, open);
-            found |= lanes.settled & lanes.t.lt(t_max);
-            for i in (lanes.candidate & !lanes.settled).lanes() {
+            if lanes.candidate.none() {
+                continue;
+            }
+            let settled = lanes.settled(lanes.in_range, r);
+            found |= settled & lanes.t().lt(t_max);
+            for i in (lanes.candidate & !settled).lanes() {
                 let t_max_i = t_max.to_array()[i];
                 if triangle::intersect(&records[k], &tri_ray(i), t_max_i).is_some() {
                     found.set(i, true);
