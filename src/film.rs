@@ -30,6 +30,8 @@
 
 use std::sync::Mutex;
 
+use rayon::prelude::*;
+
 use glam::Vec2;
 
 use crate::error::{Error, Result};
@@ -427,6 +429,41 @@ impl Film {
     pub fn recycle(&self, tile: FilmTile) {
         if let Ok(mut spare) = self.spare.0.lock() {
             spare.push((tile.sums, tile.scratch_x, tile.scratch_y));
+        }
+    }
+
+    /// `merge_tile` for each of `tiles` in order, the image's rows merged in parallel:
+    /// every pixel still receives its tiles' sums in the order of `tiles`, so the result is
+    /// bit for bit that of merging them one after the other.
+    pub fn merge_tiles<'a>(&mut self, tiles: impl Iterator<Item = &'a FilmTile> + Clone + Sync) {
+        let width = self.width as usize;
+        self.sums
+            .par_chunks_mut(width)
+            .enumerate()
+            .for_each(|(y, row)| {
+                let y = y as u32;
+                for tile in tiles.clone() {
+                    let b = tile.buffer;
+                    if y < b.y0 || y >= b.y1 {
+                        continue;
+                    }
+                    let n = b.width() as usize;
+                    let src = (y - b.y0) as usize * n;
+                    let dst = &mut row[b.x0 as usize..b.x0 as usize + n];
+                    for (d, s) in dst.iter_mut().zip(&tile.sums[src..src + n]) {
+                        for k in 0..4 {
+                            d[k] += s[k];
+                        }
+                    }
+                }
+            });
+        for tile in tiles {
+            debug_assert_eq!(
+                (tile.image_width, tile.image_height),
+                (self.width, self.height)
+            );
+            self.samples += tile.samples;
+            self.invalid_samples += tile.invalid_samples;
         }
     }
 

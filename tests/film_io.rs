@@ -225,6 +225,7 @@ fn tiles_merged_in_tile_order_are_bit_identical_for_any_thread_count() {
                     .collect()
             });
             done.sort_by_key(|(i, _)| *i);
+            let mut merged_by_rows = film.clone();
             for (_, tile) in &done {
                 film.merge_tile(tile);
             }
@@ -232,6 +233,13 @@ fn tiles_merged_in_tile_order_are_bit_identical_for_any_thread_count() {
                 bits(&film.image(1.0)),
                 bits(&reference),
                 "{filter:?}, {threads} threads"
+            );
+            // The rows merged in parallel, each pixel's tiles still in tile order.
+            merged_by_rows.merge_tiles(done.iter().map(|(_, tile)| tile));
+            assert_eq!(
+                bits(&merged_by_rows.image(1.0)),
+                bits(&reference),
+                "{filter:?}, {threads} threads, merge_tiles"
             );
         }
         // A different tiling adds the same samples in another grouping: equal up to

@@ -127,9 +127,9 @@ pub fn camera_pass(
         .par_chunks(estimate.tiles_per_task().max(1))
         .map(|batch| estimate.render_tiles(&pass, batch))
         .collect();
+    film.merge_tiles(finished.iter().flatten().map(|(tile, _)| tile));
     let mut total = PassCounts::default();
     for (tile, counts) in finished.into_iter().flatten() {
-        film.merge_tile(&tile);
         film.recycle(tile);
         total.samples += counts.samples;
         total.rays += counts.rays;
