@@ -645,10 +645,21 @@ impl FilmTile {
         let Some((y0, y1)) = clip(fy, self.buffer.y0 as i64, self.buffer.y1 as i64) else {
             return;
         };
-        weights_1d(&self.filter, x, x0, x1, &mut self.scratch_x);
-        weights_1d(&self.filter, y, y0, y1, &mut self.scratch_y);
         let v = value.0.map(f64::from);
         let stride = self.buffer.width() as usize;
+        if self.filter == ReconstructionFilter::Box {
+            // One pixel with weight 1 (|i + ½ − x| ≤ ½ for i = ⌊x⌋): the general loop's
+            // sums, 1·1·v = v exactly, without evaluating the filter.
+            let row = (y0 - self.buffer.y0 as i64) as usize * stride;
+            let s = &mut self.sums[row + (x0 - self.buffer.x0 as i64) as usize];
+            s[0] += v[0];
+            s[1] += v[1];
+            s[2] += v[2];
+            s[3] += 1.0;
+            return;
+        }
+        weights_1d(&self.filter, x, x0, x1, &mut self.scratch_x);
+        weights_1d(&self.filter, y, y0, y1, &mut self.scratch_y);
         for (j, &wy) in (y0..=y1).zip(&self.scratch_y) {
             let row = (j - self.buffer.y0 as i64) as usize * stride;
             for (i, &wx) in (x0..=x1).zip(&self.scratch_x) {

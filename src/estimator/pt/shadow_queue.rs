@@ -20,11 +20,11 @@ use crate::geometry::packet::RayLanes;
 use crate::math::Rgb;
 use crate::math::lanes::{F32x16, LANES, Mask16, U32x16, V3};
 
-/// Room for the entries of one round (16) besides fewer than a packet's worth (15) left
-/// over from earlier rounds.
-const CAPACITY: usize = 48;
+/// Entries: a round queues at most 16 and leaves fewer than 16, so the queue holds at
+/// most 31; the rest is room to cast from the front without moving the others each time.
+const CAPACITY: usize = 256;
 
-/// The queued entries, one array per field (positions `0..len`, oldest first).
+/// The queued entries, one array per field (positions `head..len`, oldest first).
 pub(super) struct ShadowQueue {
     /// Origin x, y, z, direction x, y, z and t_max of each ray.
     ray: [[f32; CAPACITY]; 7],
@@ -33,6 +33,7 @@ pub(super) struct ShadowQueue {
     /// What it adds if the ray is occluded.
     dark: [[f32; CAPACITY]; 3],
     sample: [u32; CAPACITY],
+    head: usize,
     len: usize,
 }
 
@@ -43,6 +44,7 @@ impl Default for ShadowQueue {
             lit: [[0.0; CAPACITY]; 3],
             dark: [[0.0; CAPACITY]; 3],
             sample: [0; CAPACITY],
+            head: 0,
             len: 0,
         }
     }
@@ -58,7 +60,9 @@ impl ShadowQueue {
         dark: &V3<F32x16>,
         sample: U32x16,
     ) {
-        debug_assert!(self.len + LANES <= CAPACITY, "cast before queueing more");
+        if self.len + LANES > CAPACITY {
+            self.compact();
+        }
         let at = self.len;
         let fields = [
             (ray.o.x, 0),
@@ -83,23 +87,40 @@ impl ShadowQueue {
         self.len += m.count() as usize;
     }
 
+    /// Moves the entries to the front of the arrays.
+    fn compact(&mut self) {
+        let (head, len) = (self.head, self.len);
+        for a in self
+            .ray
+            .iter_mut()
+            .chain(&mut self.lit)
+            .chain(&mut self.dark)
+        {
+            a.copy_within(head..len, 0);
+        }
+        self.sample.copy_within(head..len, 0);
+        (self.head, self.len) = (0, len - head);
+    }
+
     /// Casts the oldest sixteen entries while there are that many.
     pub fn cast_full(&mut self, geometry: &Geometry, queue: &mut [QueuedSample]) {
-        while self.len >= LANES {
+        while self.len - self.head >= LANES {
             self.cast_first(LANES, geometry, queue);
         }
     }
 
     /// Casts every entry, oldest first.
     pub fn flush(&mut self, geometry: &Geometry, queue: &mut [QueuedSample]) {
-        while self.len > 0 {
-            self.cast_first(self.len.min(LANES), geometry, queue);
+        while self.len > self.head {
+            self.cast_first((self.len - self.head).min(LANES), geometry, queue);
         }
+        (self.head, self.len) = (0, 0);
     }
 
     /// Casts the entries of sample `sample` (before something else adds to it).
     pub fn resolve(&mut self, sample: u32, geometry: &Geometry, queue: &mut [QueuedSample]) {
         // Move the sample's entries to the front, keeping both groups' order, then cast.
+        self.compact();
         let mut order = [0usize; CAPACITY];
         let entries = 0..self.len;
         let theirs = entries.clone().filter(|&i| self.sample[i] == sample);
@@ -122,25 +143,28 @@ impl ShadowQueue {
 
     /// Puts entry `order[i]` at position i.
     fn reorder(&mut self, order: &[usize]) {
-        let gather = |a: &[f32; CAPACITY]| -> [f32; CAPACITY] {
-            std::array::from_fn(|i| if i < order.len() { a[order[i]] } else { 0.0 })
-        };
-        for k in 0..7 {
-            self.ray[k] = gather(&self.ray[k]);
+        for a in self
+            .ray
+            .iter_mut()
+            .chain(&mut self.lit)
+            .chain(&mut self.dark)
+        {
+            permute_prefix(a, order);
         }
-        for k in 0..3 {
-            self.lit[k] = gather(&self.lit[k]);
-            self.dark[k] = gather(&self.dark[k]);
-        }
-        let sample = self.sample;
-        self.sample = std::array::from_fn(|i| if i < order.len() { sample[order[i]] } else { 0 });
+        permute_prefix(&mut self.sample, order);
     }
 
     /// Casts the first `n` (≤ 16) entries, adds their terms to their samples in order, and
     /// drops them.
     fn cast_first(&mut self, n: usize, geometry: &Geometry, queue: &mut [QueuedSample]) {
+        let h = self.head;
+        if h + LANES > CAPACITY {
+            self.compact();
+            return self.cast_first(n, geometry, queue);
+        }
         let load = |a: &[f32; CAPACITY]| {
-            F32x16::from_array(std::array::from_fn(|i| if i < n { a[i] } else { 0.0 }))
+            let lanes: &[f32; LANES] = a[h..h + LANES].try_into().unwrap();
+            F32x16::from_array(*lanes)
         };
         let [ox, oy, oz, dx, dy, dz, t_max] = self.ray.each_ref().map(load);
         let rays = RayLanes {
@@ -173,5 +197,23 @@ impl ShadowQueue {
 
     pub fn is_empty(&self) -> bool {
         self.len == 0
+    }
+}
+
+/// Puts `a[order[i]]` at position i, for i < order.len().
+fn permute_prefix<T: Copy + Default>(a: &mut [T; CAPACITY], order: &[usize]) {
+    // A round leaves at most 31 entries: a small copy does.
+    const SMALL: usize = 32;
+    if order.len() <= SMALL {
+        let mut moved = [T::default(); SMALL];
+        for (m, &o) in moved.iter_mut().zip(order) {
+            *m = a[o];
+        }
+        a[..order.len()].copy_from_slice(&moved[..order.len()]);
+    } else {
+        let old = *a;
+        for (x, &o) in a.iter_mut().zip(order) {
+            *x = old[o];
+        }
     }
 }
