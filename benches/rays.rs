@@ -23,7 +23,7 @@ use std::time::Duration;
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 use mltbench::geometry::bvh::{TraversalRay, TriangleBvh, TriangleList};
-use mltbench::geometry::packet::RayLanes;
+use mltbench::geometry::packet::{ClosestLanes, RayLanes};
 use mltbench::geometry::procedural::{
     cornell_box, cornell_box_with_sphere, displaced_sphere_1m, mesh_shape, uv_sphere,
 };
@@ -313,11 +313,12 @@ fn bench_cornell_queries(c: &mut Criterion) {
     // The same rays sixteen at a time (`geometry::packet`), as `pt`'s wavefront casts them.
     let (packets, shadow_packets) = (to_packets(&rays), to_packets(&shadow));
     group.bench_function("packet_kernel_incoherent/1t", |b| {
+        let mut hits = ClosestLanes::default();
         b.iter(|| {
             packets
                 .iter()
                 .map(|p| {
-                    let hits = geometry.closest_hits_lanes(p, Mask16::ALL);
+                    geometry.closest_hits_lanes(p, Mask16::ALL, &mut hits);
                     black_box(&hits).hit.count() as usize
                 })
                 .sum::<usize>()

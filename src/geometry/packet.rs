@@ -296,33 +296,23 @@ impl LaneTests {
     }
 }
 
-/// The closest hit found so far in each lane: its t and record. The edge functions of a
-/// hit settled in lanes are recomputed once at the end (`edges_of_best`); those of a hit
-/// that `triangle::intersect` decided (it may have recomputed them in f64) are kept here.
+/// The closest hit of each lane: its t (in the scaled ray's units), record, edge functions
+/// and det (lanes of `hit`).
+#[derive(Clone, Copy)]
 struct BestLanes {
     t: F32x16,
     record: U32x16,
-    hit: Mask16,
-    /// Lanes whose hit `triangle::intersect` decided, with its edge functions and det.
-    scalar: Mask16,
-    scalar_e: [[f32; 3]; LANES],
-    scalar_det: [f32; LANES],
-    /// Filled in by `edges_of_best` for every hit lane.
     e: [F32x16; 3],
     det: F32x16,
+    hit: Mask16,
 }
 
-impl BestLanes {
-    /// Takes `h` (on record `k`, decided by `triangle::intersect`) as lane `i`'s closest hit.
-    fn set(&mut self, i: usize, k: u32, h: &TriangleHit) {
-        let m = Mask16(1 << i);
-        self.t = F32x16::select(m, F32x16::splat(h.t), self.t);
-        self.record = U32x16::select(m, U32x16::splat(k), self.record);
-        self.hit |= m;
-        self.scalar |= m;
-        self.scalar_e[i] = h.e;
-        self.scalar_det[i] = h.det;
-    }
+/// The hits `triangle::intersect` decided during the scan (it may have recomputed their
+/// edge functions in f64): kept aside, since the others' are recomputed at the end.
+struct ScalarHits {
+    lanes: Mask16,
+    e: [[f32; 3]; LANES],
+    det: [f32; LANES],
 }
 
 impl PacketTriangles {
@@ -336,17 +326,20 @@ impl PacketTriangles {
         tri_ray: impl Fn(usize) -> TriangleRay,
         t_max: F32x16,
         m: Mask16,
-    ) -> BestLanes {
+        best: &mut BestLanes,
+    ) {
         let zero = F32x16::splat(0.0);
-        let mut best = BestLanes {
+        *best = BestLanes {
             t: t_max,
             record: U32x16::splat(0),
-            hit: Mask16::NONE,
-            scalar: Mask16::NONE,
-            scalar_e: [[0.0; 3]; LANES],
-            scalar_det: [0.0; LANES],
             e: [zero; 3],
             det: zero,
+            hit: Mask16::NONE,
+        };
+        let mut scalar = ScalarHits {
+            lanes: Mask16::NONE,
+            e: [[0.0; 3]; LANES],
+            det: [0.0; LANES],
         };
         for (k, tri) in self.triangles.iter().enumerate() {
             let lanes = lane_tests(tri, r, best.t, m);
@@ -365,23 +358,27 @@ impl PacketTriangles {
             best.t = F32x16::select(settled, t, best.t);
             best.record = U32x16::select(settled, U32x16::splat(k as u32), best.record);
             best.hit |= settled;
-            best.scalar &= !settled;
+            scalar.lanes &= !settled;
             for i in ((lanes.candidate & !lanes.in_range) | (closer & !settled)).lanes() {
                 let t_max_i = best.t.to_array()[i];
                 if let Some(h) = triangle::intersect(&records[k], &tri_ray(i), t_max_i) {
-                    best.set(i, k as u32, &h);
+                    let m = Mask16(1 << i);
+                    best.t = F32x16::select(m, F32x16::splat(h.t), best.t);
+                    best.record = U32x16::select(m, U32x16::splat(k as u32), best.record);
+                    best.hit |= m;
+                    scalar.lanes |= m;
+                    (scalar.e[i], scalar.det[i]) = (h.e, h.det);
                 }
             }
         }
-        self.edges_of_best(&mut best, r);
-        best
+        self.edges_of_best(best, &scalar, r);
     }
 
     /// The edge functions and det of each lane's closest hit: recomputed from its record
     /// with the same arithmetic for hits settled in lanes, kept for the others.
     #[inline(always)]
-    fn edges_of_best(&self, best: &mut BestLanes, r: &TriangleRayLanes) {
-        let m = best.hit & !best.scalar;
+    fn edges_of_best(&self, best: &mut BestLanes, scalar: &ScalarHits, r: &TriangleRayLanes) {
+        let m = best.hit & !scalar.lanes;
         if m.any() {
             let table = self.triangles.as_flattened();
             let base = best.record.shl::<4>();
@@ -389,12 +386,12 @@ impl PacketTriangles {
             best.det = sheared.det();
             best.e = sheared.e;
         }
-        for i in best.scalar.lanes() {
+        for i in scalar.lanes.lanes() {
             let m = Mask16(1 << i);
-            for (e, v) in best.e.iter_mut().zip(best.scalar_e[i]) {
+            for (e, v) in best.e.iter_mut().zip(scalar.e[i]) {
                 *e = F32x16::select(m, F32x16::splat(v), *e);
             }
-            best.det = F32x16::select(m, F32x16::splat(best.scalar_det[i]), best.det);
+            best.det = F32x16::select(m, F32x16::splat(scalar.det[i]), best.det);
         }
     }
 
@@ -430,43 +427,59 @@ impl PacketTriangles {
     }
 }
 
-/// The closest hits of sixteen rays (`Geometry::closest_hits_lanes`).
+/// The closest hits of sixteen rays, as `Geometry::closest_hits_lanes` fills them in.
 pub struct ClosestLanes {
     /// Lanes whose ray hit something.
     pub hit: Mask16,
-    found: Found,
+    /// True when the sixteen-ray test found them (`best`), false when the per-ray query
+    /// did (`one_by_one`).
+    packet: bool,
+    best: BestLanes,
+    one_by_one: [Option<ClosestHit>; LANES],
 }
 
-/// How `ClosestLanes` found its hits. Both kinds stay inline (a `ClosestLanes` lives on
-/// the stack of one round of the wavefront): boxing one would allocate per query.
-#[allow(clippy::large_enum_variant)]
-enum Found {
-    /// By the sixteen-ray test: per lane the closest record and its hit (t in the scaled
-    /// ray's units), and the scaled rays.
-    Packet {
-        best: BestLanes,
-        rays: [ScaledRay; LANES],
-    },
-    /// By the per-ray query, lane after lane.
-    OneByOne([Option<ClosestHit>; LANES]),
+impl Default for ClosestLanes {
+    fn default() -> Self {
+        let zero = F32x16::splat(0.0);
+        ClosestLanes {
+            hit: Mask16::NONE,
+            packet: false,
+            best: BestLanes {
+                t: zero,
+                record: U32x16::splat(0),
+                e: [zero; 3],
+                det: zero,
+                hit: Mask16::NONE,
+            },
+            one_by_one: [None; LANES],
+        }
+    }
 }
 
 impl ClosestLanes {
-    /// Lane `i`'s hit as the per-ray query `closest_hit` returns it.
-    pub fn closest_hit(&self, geometry: &Geometry, i: usize) -> Option<ClosestHit> {
-        match &self.found {
-            Found::OneByOne(hits) => hits[i],
-            Found::Packet { best, rays } => self.hit.get(i).then(|| {
-                let g = |v: F32x16| v.to_array()[i];
-                let hit = TriangleHit {
-                    t: g(best.t),
-                    e: best.e.map(g),
-                    det: g(best.det),
-                };
-                let record = best.record.to_array()[i];
-                geometry.found(Hit::Triangle { record, hit }, rays[i])
-            }),
+    /// Lane `i`'s hit as the per-ray query `closest_hit` returns it for lane `i` of `rays`
+    /// (the rays these hits were found for).
+    pub fn closest_hit(
+        &self,
+        geometry: &Geometry,
+        rays: &RayLanes,
+        i: usize,
+    ) -> Option<ClosestHit> {
+        if !self.packet {
+            return self.one_by_one[i];
         }
+        let ray = ScaledRay::new(&rays.lane(i))?;
+        self.hit.get(i).then(|| {
+            let g = |v: F32x16| v.to_array()[i];
+            let best = &self.best;
+            let hit = TriangleHit {
+                t: g(best.t),
+                e: best.e.map(g),
+                det: g(best.det),
+            };
+            let record = best.record.to_array()[i];
+            geometry.found(Hit::Triangle { record, hit }, ray)
+        })
     }
 }
 
@@ -487,41 +500,42 @@ impl Geometry {
     /// `closest_hit` for the rays of the lanes of `m`: the same answers, sixteen rays per
     /// triangle test on a small scene without analytic shapes (`packet.rs`), one ray at a
     /// time otherwise.
-    pub fn closest_hits_lanes(&self, rays: &RayLanes, m: Mask16) -> ClosestLanes {
+    pub fn closest_hits_lanes(&self, rays: &RayLanes, m: Mask16, out: &mut ClosestLanes) {
         if !self.bvh.is_flat() || self.has_analytic_shapes() {
-            let mut hits = [None; LANES];
+            out.packet = false;
+            out.one_by_one = [None; LANES];
             for i in m.lanes() {
-                hits[i] = self.closest_hit(&rays.lane(i));
+                out.one_by_one[i] = self.closest_hit(&rays.lane(i));
             }
-            return ClosestLanes {
-                hit: Mask16::from_fn(|i| hits[i].is_some()),
-                found: Found::OneByOne(hits),
-            };
+            out.hit = Mask16::from_fn(|i| out.one_by_one[i].is_some());
+            return;
         }
         let scaled = ScaledRayLanes::new(rays);
         let m = m & scaled.valid;
         let tri = TriangleRayLanes::new(&scaled.o, &scaled.d);
-        let per_ray = scaled.lanes();
-        let tri_ray = |i: usize| TriangleRay::new(per_ray[i].o, per_ray[i].d);
-        let best = self
-            .bvh
-            .packet()
-            .closest(self.bvh.records(), &tri, tri_ray, scaled.t_max, m);
-        ClosestLanes {
-            hit: best.hit,
-            found: Found::Packet {
-                best,
-                rays: per_ray,
-            },
-        }
+        let tri_ray = |i: usize| {
+            let s = &scaled.lanes()[i];
+            TriangleRay::new(s.o, s.d)
+        };
+        out.packet = true;
+        self.bvh.packet().closest(
+            self.bvh.records(),
+            &tri,
+            tri_ray,
+            scaled.t_max,
+            m,
+            &mut out.best,
+        );
+        out.hit = out.best.hit;
     }
 
     /// The surface data of `hits`: in lanes for the sixteen-ray test's hits, through
     /// `interaction` lane by lane otherwise. Lane by lane the same bits as `interaction`.
-    pub fn surface_lanes(&self, hits: &ClosestLanes) -> SurfaceLanes {
-        let Found::Packet { best, .. } = &hits.found else {
-            return self.surface_one_by_one(hits);
-        };
+    pub fn surface_lanes(&self, hits: &ClosestLanes, rays: &RayLanes) -> SurfaceLanes {
+        if !hits.packet {
+            return self.surface_one_by_one(hits, rays);
+        }
+        let best = &hits.best;
         let m = hits.hit;
         let packet = self.bvh.packet();
         let table = packet.triangles.as_flattened();
@@ -567,11 +581,11 @@ impl Geometry {
     }
 
     /// `surface_lanes` through `interaction`, one lane at a time.
-    fn surface_one_by_one(&self, hits: &ClosestLanes) -> SurfaceLanes {
+    fn surface_one_by_one(&self, hits: &ClosestLanes, rays: &RayLanes) -> SurfaceLanes {
         let mut v = [[[0.0f32; 3]; LANES]; 4];
         let (mut shape, mut primitive) = ([0u32; LANES], [0u32; LANES]);
         for i in hits.hit.lanes() {
-            let Some(h) = hits.closest_hit(self, i) else {
+            let Some(h) = hits.closest_hit(self, rays, i) else {
                 continue;
             };
             let si = self.interaction(&h);

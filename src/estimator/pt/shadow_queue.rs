@@ -119,6 +119,9 @@ impl ShadowQueue {
 
     /// Casts the entries of sample `sample` (before something else adds to it).
     pub fn resolve(&mut self, sample: u32, geometry: &Geometry, queue: &mut [QueuedSample]) {
+        if !self.sample[self.head..self.len].contains(&sample) {
+            return;
+        }
         // Move the sample's entries to the front, keeping both groups' order, then cast.
         self.compact();
         let mut order = [0usize; CAPACITY];

@@ -100,6 +100,7 @@ impl PathSample {
     ) {
         debug_assert!(shadows.is_empty());
         let mut lanes = PathLanes::default();
+        let mut hits = HitLanes::default();
         let mut next = 0usize;
         let mut sampler = pass.camera_sampler();
         // Camera samples start in lanes where they can: independent pixel samples, a
@@ -136,7 +137,7 @@ impl PathSample {
             if lanes.live.none() {
                 break;
             }
-            self.advance_lanes(pass, &mut lanes, queue, shadows);
+            self.advance_lanes(pass, &mut lanes, &mut hits, queue, shadows);
         }
         shadows.flush(&pass.scene.geometry, queue);
     }
@@ -216,6 +217,7 @@ impl PathSample {
         &self,
         pass: &PassContext,
         lanes: &mut PathLanes,
+        hits: &mut HitLanes,
         queue: &mut [QueuedSample],
         shadows: &mut ShadowQueue,
     ) {
@@ -229,7 +231,7 @@ impl PathSample {
         let zero = U32x16::splat(0);
 
         // The closest hits.
-        let hits = HitLanes::trace(scene, lanes);
+        hits.trace(scene, lanes);
         lanes.rays = lanes.rays + U32x16::select(live, one, zero);
 
         // Arriving (`arrive`): escaped rays and emitters seen by the scalar code; the other
@@ -257,7 +259,7 @@ impl PathSample {
         // Scattering: diffuse surfaces in lanes, the others one by one.
         let going = live & !ended;
         let diffuse = going & U32x16::gather(&tables.diffuse, hits.shape, going).eq(one);
-        ended |= self.scatter_diffuse(scene, tables, lanes, &hits, diffuse, shadows);
+        ended |= self.scatter_diffuse(scene, tables, lanes, hits, diffuse, shadows);
         shadows.cast_full(&scene.geometry, queue);
         for lane in (going & !diffuse).lanes() {
             let mut state = self.take_path(scene, lanes, lane, queue, shadows);
