@@ -861,3 +861,125 @@ fn stream_queries_match_single_ray_queries() {
     // The test means something only if most rays hit and some miss.
     assert!(hits > rays.len() / 2 && hits < rays.len(), "{hits} hits");
 }
+
+/// Sixteen rays per query (`closest_hits_lanes`, `surface_lanes`, `occluded_lanes`): each
+/// lane must answer exactly as the per-ray queries do (same surface, same bits), on a small
+/// scene tested sixteen rays per triangle and on scenes answered one ray at a time (a tree,
+/// analytic shapes). The rays include ones aimed exactly at shared vertices (zero edge
+/// functions), rays leaving surfaces (T near its error bound), short segments and rays
+/// that cannot hit anything.
+#[test]
+fn packet_queries_match_single_ray_queries() {
+    use mltbench::geometry::packet::{ClosestLanes, RayLanes};
+    use mltbench::math::lanes::{F32x16, Mask16, V3};
+
+    let mut small = cornell_box(1.0);
+    small.push(mesh_shape(
+        "rounded",
+        cube_sphere(Vec3::new(0.6, 0.3, 0.4), 0.15, 1),
+    ));
+    for (name, shapes) in [
+        ("small", small),
+        ("tree and analytic", scaled_scene(1.0, Vec3::ZERO)),
+    ] {
+        let g = Geometry::build(&shapes);
+        if name == "small" {
+            let n = g.triangle_count();
+            assert!(n <= mltbench::geometry::flat::FLAT_LIMIT, "{n} triangles");
+        }
+        let vertices: Vec<Vec3> = shapes
+            .iter()
+            .filter_map(|s| match &s.geometry {
+                ShapeGeometry::Mesh(m) => Some(m.positions.clone()),
+                _ => None,
+            })
+            .flatten()
+            .collect();
+        let mut rng = Random::new(2024);
+        let b = g.bounds();
+        let mut rays: Vec<Ray> = Vec::new();
+        for i in 0..16 * 4000 {
+            let o = rng.in_box(b.min, b.max);
+            let mut ray = match i % 4 {
+                // At a vertex, exactly.
+                0 => Ray::new(o, vertices[rng.below(vertices.len())] - o),
+                // Leaving a surface.
+                1 => match g.intersect(&Ray::new(o, rng.direction())) {
+                    Some(si) => si.spawn_ray(rng.direction()),
+                    None => Ray::new(o, rng.direction()),
+                },
+                _ => Ray::new(o, rng.direction()),
+            };
+            if i % 7 == 0 {
+                ray.t_max = rng.f32() * 0.8;
+            }
+            rays.push(ray);
+        }
+        rays[3].d = Vec3::ZERO;
+        rays[18].o = Vec3::NAN;
+        rays[33].t_max = -1.0;
+        let (mut hits, mut blocked, mut clear) = (0, 0, 0);
+        let mut closest = ClosestLanes::default();
+        for (k, chunk) in rays.chunks_exact(16).enumerate() {
+            let lanes =
+                |f: &dyn Fn(&Ray) -> f32| F32x16::from_array(std::array::from_fn(|i| f(&chunk[i])));
+            let packet = RayLanes {
+                o: V3::new(lanes(&|r| r.o.x), lanes(&|r| r.o.y), lanes(&|r| r.o.z)),
+                d: V3::new(lanes(&|r| r.d.x), lanes(&|r| r.d.y), lanes(&|r| r.d.z)),
+                t_max: lanes(&|r| r.t_max),
+            };
+            // Some packets leave lanes out.
+            let m = if k % 5 == 0 {
+                Mask16(0xf0f3)
+            } else {
+                Mask16::ALL
+            };
+            g.closest_hits_lanes(&packet, m, &mut closest);
+            let surface = g.surface_lanes(&closest, &packet);
+            let occluded = g.occluded_lanes(&packet, m);
+            let bits =
+                |v: &V3<F32x16>, i: usize| [v.x, v.y, v.z].map(|c| c.to_array()[i].to_bits());
+            for (i, ray) in chunk.iter().enumerate() {
+                let want = if m.get(i) { g.intersect(ray) } else { None };
+                assert_eq!(closest.hit.get(i), want.is_some(), "{name}: {ray:?}");
+                assert_eq!(
+                    occluded.get(i),
+                    m.get(i) && g.occluded(ray),
+                    "{name}: occluded {ray:?}"
+                );
+                blocked += occluded.get(i) as usize;
+                clear += (m.get(i) && !occluded.get(i)) as usize;
+                let Some(want) = want else {
+                    continue;
+                };
+                hits += 1;
+                let got = g.interaction(&closest.closest_hit(&g, &packet, i).unwrap());
+                assert_eq!((got.shape, got.primitive), (want.shape, want.primitive));
+                assert_eq!(got.t.to_bits(), want.t.to_bits(), "{name}: {ray:?}");
+                assert_eq!(got.p, want.p, "{name}: {ray:?}");
+                let v = |x: Vec3| x.to_array().map(f32::to_bits);
+                assert_eq!(bits(&surface.p, i), v(want.p), "{name}: p {ray:?}");
+                assert_eq!(
+                    bits(&surface.p_error, i),
+                    v(want.p_error),
+                    "{name}: {ray:?}"
+                );
+                assert_eq!(bits(&surface.ng, i), v(want.ng), "{name}: ng {ray:?}");
+                assert_eq!(bits(&surface.ns, i), v(want.ns), "{name}: ns {ray:?}");
+                assert_eq!(
+                    (surface.shape.to_array()[i], surface.primitive.to_array()[i]),
+                    (want.shape, want.primitive)
+                );
+            }
+        }
+        // Most rays hit, some miss, some segments are blocked and some not.
+        assert!(
+            hits > rays.len() / 2 && hits < rays.len(),
+            "{name}: {hits} hits"
+        );
+        assert!(
+            blocked > 100 && clear > 100,
+            "{name}: {blocked} blocked, {clear} clear"
+        );
+    }
+}
