@@ -252,17 +252,24 @@ fn lane_tests(tri: &PacketTriangle, r: &TriangleRayLanes, t_max: F32x16, m: Mask
     let [e0, e1, e2] = sheared.e;
     let [z0, z1, z2] = sheared.z;
     let zero = F32x16::splat(0.0);
-    let any_neg = e0.lt(zero) | e1.lt(zero) | e2.lt(zero);
-    let any_pos = e0.gt(zero) | e1.gt(zero) | e2.gt(zero);
-    let all_nonzero = e0.ne(zero) & e1.ne(zero) & e2.ne(zero);
+    // Edge functions of both signs: no hit. (A NaN among them may be read either way
+    // here: such a lane has NaN in T and det, fails `in_range`, and cannot hit.)
+    let lowest = e0.min_lt(e1).min_lt(e2);
+    let highest = e0.max_gt(e1).max_gt(e2);
+    let mixed = lowest.lt(zero) & highest.gt(zero);
+    // No zero edge function. A product that underflows to zero only sends the lane to
+    // `triangle::intersect`, which decides it exactly.
+    let all_nonzero = ((e0 * e1) * e2).ne(zero);
     let det = sheared.det();
     let t_num = (e0 * (z0 * r.sz) + e1 * (z1 * r.sz)) + e2 * (z2 * r.sz);
-    // t = T/det with both made positive, as `triangle::hit_from`.
-    let flip = det.lt(zero);
-    let t_num_p = F32x16::select(flip, -t_num, t_num);
-    let det_p = F32x16::select(flip, -det, det);
+    // t = T/det with both made positive, as `triangle::hit_from` (which flips for det < 0;
+    // flipping by det's sign bit differs only for det = −0 or NaN, lanes that fail
+    // `in_range` either way).
+    let sign = det.to_bits() & U32x16::splat(0x8000_0000);
+    let t_num_p = F32x16::from_bits(t_num.to_bits() ^ sign);
+    let det_p = det.abs();
     let in_range = t_num_p.gt(zero) & t_num_p.lt(t_max * det_p);
-    let candidate = m & !(any_neg & any_pos) & (!all_nonzero | in_range);
+    let candidate = m & !mixed & (!all_nonzero | in_range);
     LaneTests {
         sheared,
         t_num_p,
