@@ -568,6 +568,13 @@ impl Film {
     }
 
     /// The current estimate: filtered pixel values plus the splats times `splat_scale`.
+    /// The accumulators, per pixel Σ w·r, Σ w·g, Σ w·b, Σ w (for tests of merge order: the
+    /// image rounds their last bits away).
+    #[cfg(test)]
+    pub(crate) fn sums(&self) -> &[[f64; 4]] {
+        &self.sums
+    }
+
     pub fn image(&self, splat_scale: f64) -> Image {
         let mut image = Image::new(self.width, self.height);
         for j in 0..self.height as usize {

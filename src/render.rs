@@ -36,9 +36,17 @@ pub struct RenderOutput {
     pub interrupted: bool,
 }
 
+/// Passes are run several at a time (`Estimator::run_passes`) in chunks of about this long:
+/// the threads then wait for each other once per chunk instead of once per pass, while a
+/// stop request or a time budget is still seen within a fraction of a second.
+const CHUNK_SECONDS: f64 = 0.05;
+
+/// The most passes in one chunk.
+const MAX_CHUNK: u32 = 64;
+
 /// Runs `estimator` on `scene` until `budget` is spent, or, after at least one pass, until a
-/// stop is requested (`interrupt`). `on_pass(done, elapsed)` is called after every pass (for
-/// progress bars).
+/// stop is requested (`interrupt`). `on_pass(done, elapsed)` is called after every chunk of
+/// passes (for progress bars). The image is the same bits as one pass at a time.
 pub fn render(
     scene: &Scene,
     estimator: &mut dyn Estimator,
@@ -48,6 +56,8 @@ pub fn render(
     let start = Instant::now();
     let mut pass = 0u32;
     let mut interrupted = false;
+    // Start with one pass to time it, then chunks of about CHUNK_SECONDS.
+    let mut chunk = 1u32;
     loop {
         if budget.is_spent(pass, start) {
             break;
@@ -56,9 +66,22 @@ pub fn render(
             interrupted = true;
             break;
         }
-        estimator.run_pass(scene, pass);
-        pass += 1;
+        let count = match budget {
+            Budget::Passes(n) => chunk.min(n - pass),
+            Budget::Seconds(_) => chunk,
+        };
+        let chunk_start = Instant::now();
+        estimator.run_passes(scene, pass, count);
+        pass += count;
         on_pass(pass, start.elapsed());
+        let seconds_per_pass = chunk_start.elapsed().as_secs_f64() / count as f64;
+        chunk = (CHUNK_SECONDS / seconds_per_pass.max(1e-9)).clamp(1.0, MAX_CHUNK as f64) as u32;
+        if let Budget::Seconds(s) = budget {
+            // No more passes than the time left holds (rounded up, as one pass at a time
+            // would start its last pass before the time is up).
+            let left = (s - start.elapsed().as_secs_f64()).max(0.0);
+            chunk = chunk.min((left / seconds_per_pass.max(1e-9)).ceil().max(1.0) as u32);
+        }
     }
     RenderOutput {
         image: estimator.image(),

@@ -66,6 +66,56 @@ fn one_and_two_threads_give_bit_identical_images() {
     }
 }
 
+/// Passes run several at a time (`run_passes`, as `render` does in chunks) give the bits of
+/// one pass at a time, for every estimator, with a box and with a Gaussian filter (whose
+/// tiles overlap, so the merge order shows in the bits).
+#[test]
+fn passes_in_chunks_give_the_bits_of_one_pass_at_a_time() {
+    let path = scenes_dir().join("cbox.xml");
+    let gaussian = {
+        let text = std::fs::read_to_string(&path).unwrap();
+        let text = text
+            .replace(
+                "<default name=\"res\" value=\"256\"/>",
+                "<default name=\"res\" value=\"40\"/>",
+            )
+            .replace("<rfilter type=\"box\"/>", "<rfilter type=\"gaussian\"/>");
+        assert!(text.contains("gaussian"));
+        Scene::build(mitsuba::load_str(&text, &path).unwrap()).unwrap()
+    };
+    for (filter, scene) in [("box", load_small(&path, 40)), ("gaussian", gaussian)] {
+        for (name, params) in [
+            ("pt", vec!["wavefront=true"]),
+            ("pt", vec!["wavefront=false"]),
+            ("eyelight", vec![]),
+            ("lt", vec![]),
+            ("bdpt", vec![]),
+        ] {
+            let run = |chunks: &[u32]| {
+                let params = Params::parse(&params).unwrap();
+                let mut e = estimator::create(name, &params, &scene, 3).unwrap();
+                let mut first = 0;
+                for &count in chunks {
+                    e.run_passes(&scene, first, count);
+                    first += count;
+                }
+                (bits(&e.image()), e.stats())
+            };
+            let one_at_a_time = run(&[1; 16]);
+            assert_eq!(
+                run(&[5, 11]),
+                one_at_a_time,
+                "{name} {params:?}, {filter} filter"
+            );
+            assert_eq!(
+                run(&[16]),
+                one_at_a_time,
+                "{name} {params:?}, {filter} filter"
+            );
+        }
+    }
+}
+
 #[test]
 fn every_builtin_scene_renders_a_finite_image() {
     for entry in std::fs::read_dir(scenes_dir()).unwrap() {

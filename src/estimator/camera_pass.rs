@@ -1,8 +1,9 @@
-//! One pass of a camera-side estimator: every pixel takes one sample, tile by tile.
+//! Passes of a camera-side estimator: in each, every pixel takes one sample, tile by tile.
 //!
 //! Tiles have a fixed size (not tied to the thread count), each pixel sample seeds its own
-//! random stream from (seed, pixel, sample index), and finished tiles merge into the film in
-//! tile order: the image is bit-identical for any number of threads (DESIGN.md §3).
+//! random stream from (seed, pixel, sample index), and finished tiles merge into the film
+//! pass by pass, in tile order: the image is bit-identical for any number of threads
+//! (DESIGN.md §3), and for passes run one by one or several at once (`camera_passes`).
 
 use rayon::prelude::*;
 
@@ -14,6 +15,7 @@ use crate::geometry::Ray;
 use crate::image::Image;
 use crate::math::Rgb;
 use glam::Vec2;
+use std::ops::Range;
 use std::sync::Arc;
 
 use crate::sampler::Sampler;
@@ -42,24 +44,39 @@ pub trait CameraSampleFn: Sync {
         1
     }
 
-    /// Takes the pass's sample of every pixel of `rects` (consecutive tiles, in order) and
-    /// returns one finished tile with its counts per rect. By default one sample after the
-    /// other (`render_tile`); an estimator may trace them otherwise, but must return the
-    /// tile `render_tile` would (the same samples added in the same order).
-    fn render_tiles(&self, pass: &PassContext, rects: &[PixelRect]) -> Vec<(FilmTile, PassCounts)> {
-        rects
-            .iter()
-            .map(|&rect| render_tile(pass, rect, self))
-            .collect()
+    /// Takes each pass's sample of every pixel of `rects` (consecutive tiles, in order) and
+    /// returns one finished tile with its counts per pass and rect, pass by pass (for each
+    /// pass of `ctx.passes`, the rects in order). By default one sample after the other
+    /// (`render_tile`); an estimator may trace them otherwise, but must return the tiles
+    /// `render_tile` would (the same samples added in the same order).
+    fn render_tiles(&self, ctx: &PassContext, rects: &[PixelRect]) -> Vec<(FilmTile, PassCounts)> {
+        render_tiles_one_by_one(ctx, rects, self)
     }
 }
 
-/// What every task of a pass shares.
+/// `CameraSampleFn::render_tiles` by default: `render_tile` for each pass and rect.
+pub fn render_tiles_one_by_one(
+    ctx: &PassContext,
+    rects: &[PixelRect],
+    estimate: &(impl CameraSampleFn + ?Sized),
+) -> Vec<(FilmTile, PassCounts)> {
+    ctx.passes
+        .clone()
+        .flat_map(|pass| {
+            rects
+                .iter()
+                .map(move |&rect| render_tile(ctx, rect, pass, estimate))
+        })
+        .collect()
+}
+
+/// What every task of a run of passes shares.
 pub struct PassContext<'a> {
     pub scene: &'a Scene,
     pub film: &'a Film,
     pub seed: u64,
-    pub pass_index: u32,
+    /// The passes to take (sample indices of every pixel).
+    pub passes: Range<u32>,
     pub pixel_samples: &'a Arc<PixelSamples>,
 }
 
@@ -71,20 +88,20 @@ impl PassContext<'_> {
     }
 }
 
-/// Takes the pass's sample of every pixel of `rect`, row by row, one after the other.
+/// Takes sample `pass` of every pixel of `rect`, row by row, one after the other.
 pub fn render_tile(
-    pass: &PassContext,
+    ctx: &PassContext,
     rect: PixelRect,
+    pass: u32,
     estimate: &(impl CameraSampleFn + ?Sized),
 ) -> (FilmTile, PassCounts) {
-    let mut tile = pass.film.tile(rect);
+    let mut tile = ctx.film.tile(rect);
     let mut counts = PassCounts::default();
-    let mut sampler = pass.camera_sampler();
+    let mut sampler = ctx.camera_sampler();
     for y in rect.y0..rect.y1 {
         for x in rect.x0..rect.x1 {
-            let (raster, ray) =
-                start_camera_sample(&pass.scene.camera, &mut sampler, x, y, pass.pass_index);
-            let (value, rays) = estimate.radiance(pass.scene, &ray, &mut sampler);
+            let (raster, ray) = start_camera_sample(&ctx.scene.camera, &mut sampler, x, y, pass);
+            let (value, rays) = estimate.radiance(ctx.scene, &ray, &mut sampler);
             counts.add_sample(&mut tile, raster, value, rays);
         }
     }
@@ -105,29 +122,37 @@ impl PassCounts {
     }
 }
 
-/// Takes sample number `pass_index` of every pixel and adds it to `film`.
-/// Samples that are NaN, infinite or negative are dropped and counted.
-pub fn camera_pass(
+/// Takes samples `passes` of every pixel and adds them to `film`, pass by pass in tile
+/// order (the same bits as one call per pass). Samples that are NaN, infinite or negative
+/// are dropped and counted.
+pub fn camera_passes(
     scene: &Scene,
     film: &mut Film,
     seed: u64,
-    pass_index: u32,
+    passes: Range<u32>,
     pixel_samples: &Arc<PixelSamples>,
     estimate: &impl CameraSampleFn,
 ) -> PassCounts {
     let rects = film.tiles(TILE_SIZE);
-    let pass = PassContext {
+    let count = passes.len();
+    let ctx = PassContext {
         scene,
         film,
         seed,
-        pass_index,
+        passes,
         pixel_samples,
     };
     let finished: Vec<Vec<(FilmTile, PassCounts)>> = rects
         .par_chunks(estimate.tiles_per_task().max(1))
-        .map(|batch| estimate.render_tiles(&pass, batch))
+        .map(|batch| estimate.render_tiles(&ctx, batch))
         .collect();
-    film.merge_tiles(finished.iter().flatten().map(|(tile, _)| tile));
+    // Each batch's tiles are pass by pass: pass k's are its k-th run of equal length.
+    for k in 0..count {
+        film.merge_tiles(finished.iter().flat_map(move |batch| {
+            let n = batch.len() / count;
+            batch[k * n..(k + 1) * n].iter().map(|(tile, _)| tile)
+        }));
+    }
     let mut total = PassCounts::default();
     for (tile, counts) in finished.into_iter().flatten() {
         film.recycle(tile);
@@ -193,6 +218,12 @@ impl<S: CameraSampleFn + Send> CameraEstimator<S> {
     pub fn sample_fn(&self) -> &S {
         &self.sample
     }
+
+    /// The film the passes accumulate in.
+    #[cfg(test)]
+    pub(crate) fn film(&self) -> &Film {
+        &self.film
+    }
 }
 
 impl<S: CameraSampleFn + Send> Estimator for CameraEstimator<S> {
@@ -201,15 +232,19 @@ impl<S: CameraSampleFn + Send> Estimator for CameraEstimator<S> {
     }
 
     fn run_pass(&mut self, scene: &Scene, pass_index: u32) {
-        let counts = camera_pass(
+        self.run_passes(scene, pass_index, 1);
+    }
+
+    fn run_passes(&mut self, scene: &Scene, first: u32, count: u32) {
+        let counts = camera_passes(
             scene,
             &mut self.film,
             self.seed,
-            pass_index,
+            first..first + count,
             &self.pixel_samples,
             &self.sample,
         );
-        self.stats.passes += 1;
+        self.stats.passes += count as u64;
         self.stats.samples += counts.samples;
         self.stats.rays += counts.rays;
         self.stats.invalid_samples += counts.invalid;
@@ -221,5 +256,48 @@ impl<S: CameraSampleFn + Send> Estimator for CameraEstimator<S> {
 
     fn stats(&self) -> Stats {
         self.stats.clone()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::estimator::pt;
+    use crate::scene::mitsuba;
+
+    /// Passes taken several at a time merge into the film in the order of one pass at a
+    /// time, down to the f64 accumulators' bits (which the image rounds away): a Gaussian
+    /// filter's tiles overlap, so any other order shows.
+    #[test]
+    fn passes_in_one_go_merge_as_one_pass_at_a_time() {
+        let path =
+            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/scenes/cbox.xml");
+        let text = std::fs::read_to_string(&path)
+            .unwrap()
+            .replace(r#"<rfilter type="box"/>"#, r#"<rfilter type="gaussian"/>"#);
+        let params = [("res".to_string(), "40".to_string())];
+        let scene = Scene::build(mitsuba::load_str_with(&text, &path, &params).unwrap()).unwrap();
+        for wavefront in [true, false] {
+            let settings = pt::PtSettings {
+                wavefront,
+                ..pt::PtSettings::from_params(&Default::default(), &scene).unwrap()
+            };
+            let sums = |chunks: &[u32]| {
+                let mut e = pt::new(&scene, 5, settings).unwrap();
+                let mut first = 0;
+                for &count in chunks {
+                    e.run_passes(&scene, first, count);
+                    first += count;
+                }
+                e.film()
+                    .sums()
+                    .iter()
+                    .flat_map(|s| s.map(f64::to_bits))
+                    .collect::<Vec<_>>()
+            };
+            let one_at_a_time = sums(&[1; 12]);
+            assert!(sums(&[5, 7]) == one_at_a_time, "wavefront {wavefront}");
+            assert!(sums(&[12]) == one_at_a_time, "wavefront {wavefront}");
+        }
     }
 }

@@ -37,6 +37,14 @@ pub trait Estimator: Send {
     fn name(&self) -> &str;
     /// Adds one pass of work (for camera estimators: one sample per pixel).
     fn run_pass(&mut self, scene: &Scene, pass_index: u32);
+    /// Adds passes `first..first + count`: the same bits as `run_pass` for each in order.
+    /// Estimators that can take several passes in one go (fewer waits for the slowest
+    /// thread) override it.
+    fn run_passes(&mut self, scene: &Scene, first: u32, count: u32) {
+        for pass in first..first + count {
+            self.run_pass(scene, pass);
+        }
+    }
     /// The current estimate of radiance per pixel.
     fn image(&self) -> Image;
     fn stats(&self) -> Stats;

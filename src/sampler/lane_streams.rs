@@ -36,18 +36,24 @@ impl LaneStreams {
         }
     }
 
-    /// Lanes `m` start the streams of samples `index` of pixels (x, y) (per lane), as
+    /// Lanes `m` start the streams of samples `index` of pixels (x, y) (all per lane), as
     /// `IndependentSampler::start_pixel_sample` seeds them: the hash of (seed, x, y, index)
     /// expanded by SplitMix64 into the four state words.
-    pub fn start_pixel_samples(&mut self, m: Mask16, seed: u64, x: U32x16, y: U32x16, index: u64) {
+    pub fn start_pixel_samples(
+        &mut self,
+        m: Mask16,
+        seed: u64,
+        x: U32x16,
+        y: U32x16,
+        index: U32x16,
+    ) {
         let (x_lo, x_hi) = x.to_u64_halves();
         let (y_lo, y_hi) = y.to_u64_halves();
+        let (i_lo, i_hi) = index.to_u64_halves();
         let (m_lo, m_hi) = m.halves();
-        for (h, (px, py, keep)) in [(x_lo, y_lo, m_lo), (x_hi, y_hi, m_hi)]
-            .into_iter()
-            .enumerate()
-        {
-            let key = hash_words_lanes(&[U64x8::splat(seed), px, py, U64x8::splat(index)]);
+        let halves = [(x_lo, y_lo, i_lo, m_lo), (x_hi, y_hi, i_hi, m_hi)];
+        for (h, (px, py, pi, keep)) in halves.into_iter().enumerate() {
+            let key = hash_words_lanes(&[U64x8::splat(seed), px, py, pi]);
             // SplitMix64 seeded with `key` (rand_xoshiro's `seed_from_u64`): word k is the
             // finaliser of key + (k + 1)·φ, which `mix64` of key + k·φ is.
             let mut x = key;
@@ -191,11 +197,13 @@ mod tests {
         let xs = U32x16::from_array(std::array::from_fn(|i| 3 * i as u32 + 1));
         let ys = U32x16::from_array(std::array::from_fn(|i| 1000 - i as u32));
         let before = lanes.clone_states();
-        lanes.start_pixel_samples(m, 17, xs, ys, 5_000_000_000);
+        let index = U32x16::from_array(std::array::from_fn(|i| 4_000_000_000 - 7 * i as u32));
+        lanes.start_pixel_samples(m, 17, xs, ys, index);
         for (i, &old) in before.iter().enumerate() {
             let want = if m.get(i) {
                 let mut s = IndependentSampler::new(17);
-                s.start_pixel_sample((3 * i as u32 + 1, 1000 - i as u32), 5_000_000_000);
+                let index = 4_000_000_000 - 7 * i as u64;
+                s.start_pixel_sample((3 * i as u32 + 1, 1000 - i as u32), index);
                 s.state()
             } else {
                 old

@@ -29,7 +29,9 @@ mod path_lanes;
 mod shadow_queue;
 mod wavefront;
 
-use super::camera_pass::{CameraEstimator, CameraSampleFn, PassContext, PassCounts, render_tile};
+use super::camera_pass::{
+    CameraEstimator, CameraSampleFn, PassContext, PassCounts, render_tiles_one_by_one,
+};
 use crate::error::{Error, Result};
 use crate::film::{FilmTile, PixelRect};
 use crate::geometry::{Ray, SurfaceInteraction};
@@ -358,14 +360,11 @@ impl CameraSampleFn for PathSample {
         }
     }
 
-    fn render_tiles(&self, pass: &PassContext, rects: &[PixelRect]) -> Vec<(FilmTile, PassCounts)> {
+    fn render_tiles(&self, ctx: &PassContext, rects: &[PixelRect]) -> Vec<(FilmTile, PassCounts)> {
         if self.settings.wavefront {
-            self.render_tiles_in_lanes(pass, rects)
+            self.render_tiles_in_lanes(ctx, rects)
         } else {
-            rects
-                .iter()
-                .map(|&rect| render_tile(pass, rect, self))
-                .collect()
+            render_tiles_one_by_one(ctx, rects, self)
         }
     }
 }

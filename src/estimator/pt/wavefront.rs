@@ -39,16 +39,19 @@ pub(super) const TILES_PER_TASK: usize = 4;
 #[derive(Clone, Copy)]
 pub(super) struct QueuedSample {
     pixel: (u32, u32),
+    /// The pass: the sample's index among its pixel's samples.
+    pass: u32,
     raster: Vec2,
     pub value: Rgb,
     rays: u64,
 }
 
 impl PathSample {
-    /// `CameraSampleFn::render_tiles` for `pt`: the same tiles, traced in lanes.
+    /// `CameraSampleFn::render_tiles` for `pt`: the same tiles, traced in lanes (the samples
+    /// of all passes of `ctx` in one queue).
     pub(super) fn render_tiles_in_lanes(
         &self,
-        pass: &PassContext,
+        ctx: &PassContext,
         rects: &[PixelRect],
     ) -> Vec<(FilmTile, PassCounts)> {
         // Each worker thread keeps its queue from batch to batch (no allocation per batch).
@@ -59,26 +62,31 @@ impl PathSample {
         QUEUE.with_borrow_mut(|queue| {
             SHADOWS.with_borrow_mut(|shadows| {
                 queue.clear();
-                queue.extend(
-                    rects
-                        .iter()
-                        .flat_map(|r| {
-                            (r.y0..r.y1).flat_map(move |y| (r.x0..r.x1).map(move |x| (x, y)))
-                        })
-                        .map(|pixel| QueuedSample {
-                            pixel,
-                            raster: Vec2::ZERO,
-                            value: Rgb::BLACK,
-                            rays: 0,
-                        }),
-                );
-                self.trace_queue(pass, queue, shadows);
+                // Pass by pass, tile by tile, row by row: the order `render_tile` takes them.
+                for pass in ctx.passes.clone() {
+                    queue.extend(
+                        rects
+                            .iter()
+                            .flat_map(|r| {
+                                (r.y0..r.y1).flat_map(move |y| (r.x0..r.x1).map(move |x| (x, y)))
+                            })
+                            .map(|pixel| QueuedSample {
+                                pixel,
+                                pass,
+                                raster: Vec2::ZERO,
+                                value: Rgb::BLACK,
+                                rays: 0,
+                            }),
+                    );
+                }
+                self.trace_queue(ctx, queue, shadows);
                 // Finished samples go to their tiles in queue order, as `render_tile` adds them.
                 let mut samples = queue.iter();
-                rects
-                    .iter()
+                ctx.passes
+                    .clone()
+                    .flat_map(|_| rects.iter())
                     .map(|&rect| {
-                        let mut tile = pass.film.tile(rect);
+                        let mut tile = ctx.film.tile(rect);
                         let mut counts = PassCounts::default();
                         let n = ((rect.x1 - rect.x0) * (rect.y1 - rect.y0)) as usize;
                         for q in samples.by_ref().take(n) {
@@ -117,13 +125,8 @@ impl PathSample {
                 while next < queue.len() && !lanes.live.get(lane) {
                     let q = &mut queue[next];
                     let (x, y) = q.pixel;
-                    let (raster, ray) = start_camera_sample(
-                        &pass.scene.camera,
-                        &mut sampler,
-                        x,
-                        y,
-                        pass.pass_index,
-                    );
+                    let (raster, ray) =
+                        start_camera_sample(&pass.scene.camera, &mut sampler, x, y, q.pass);
                     q.raster = raster;
                     if self.max_depth() > 0 {
                         lanes.put(lane, &self.start(&ray));
@@ -151,13 +154,14 @@ impl PathSample {
         queue: &mut [QueuedSample],
         mut next: usize,
     ) -> usize {
-        let (mut x, mut y) = ([0u32; LANES], [0u32; LANES]);
+        let (mut x, mut y, mut index) = ([0u32; LANES], [0u32; LANES], [0u32; LANES]);
         let mut m = Mask16::NONE;
         for lane in (!lanes.live).lanes() {
             if next == queue.len() {
                 break;
             }
             (x[lane], y[lane]) = queue[next].pixel;
+            index[lane] = queue[next].pass;
             lanes.sample[lane] = next as u32;
             m.set(lane, true);
             next += 1;
@@ -168,7 +172,7 @@ impl PathSample {
         let (x, y) = (U32x16::from_array(x), U32x16::from_array(y));
         lanes
             .streams
-            .start_pixel_samples(m, pass.seed, x, y, pass.pass_index as u64);
+            .start_pixel_samples(m, pass.seed, x, y, U32x16::from_array(index));
         let (ux, uy) = lanes.streams.next_2d(m);
         let (rx, ry) = raster_in_pixel_lanes(x, y, ux, uy);
         let rays = pass
