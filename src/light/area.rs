@@ -6,7 +6,7 @@
 use glam::{Vec2, Vec3};
 
 use crate::light::shape_sampling::ShapeSampler;
-use crate::light::{EmissionSample, LightPoint, LightSample, LightSampleLanes};
+use crate::light::{EmissionLanes, EmissionSample, LightPoint, LightSample, LightSampleLanes};
 use crate::math::lanes::{F32x16, Mask16, V3};
 use crate::math::{Frame, INV_PI, PI, Rgb, warp};
 
@@ -101,6 +101,35 @@ impl AreaLight {
             ),
             pdf_solid_angle: s.pdf_solid_angle,
             pdf_area: s.pdf_area,
+            delta: false,
+        })
+    }
+
+    /// `le` towards `w` and `pdf_li` from `r` at hit points (`p`, `n`, `front`), per lane,
+    /// as `le` and `pdf_li` compute them; None where the shape's density is not done in
+    /// lanes (spheres).
+    #[inline]
+    pub fn emission_lanes(
+        &self,
+        p: V3<F32x16>,
+        n: V3<F32x16>,
+        front: V3<F32x16>,
+        w: V3<F32x16>,
+        r: V3<F32x16>,
+    ) -> Option<EmissionLanes> {
+        let zero = F32x16::splat(0.0);
+        let pdf = self.shape.pdf_from_lanes(r, p, n)?;
+        // One-sided: only points facing the reference point have a density.
+        let faces_r = front.dot(r - p).gt(zero);
+        let c = |v: f32| F32x16::splat(v);
+        Some(EmissionLanes {
+            emits: front.dot(w).gt(zero),
+            radiance: V3::new(
+                c(self.radiance.r()),
+                c(self.radiance.g()),
+                c(self.radiance.b()),
+            ),
+            pdf_li: F32x16::select(faces_r, pdf, zero),
         })
     }
 

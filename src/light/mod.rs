@@ -96,9 +96,9 @@ pub struct LightSample {
     pub delta: bool,
 }
 
-/// `LightSample`s of area lights in sixteen lanes (`Light::sample_li_lanes`): the lanes of
-/// `ok` have a sample. Their points lie at a finite distance, are not deltas, and their
-/// `front` is `n`.
+/// `LightSample`s of area and point lights in sixteen lanes (`Light::sample_li_lanes`): the
+/// lanes of `ok` have a sample. Their points lie at a finite distance, and their `front` is
+/// `n`.
 #[derive(Clone, Copy, Debug)]
 pub struct LightSampleLanes {
     pub ok: Mask16,
@@ -109,6 +109,19 @@ pub struct LightSampleLanes {
     pub radiance: V3<F32x16>,
     pub pdf_solid_angle: F32x16,
     pub pdf_area: f32,
+    /// A point light (a delta in position): `n`, `p_error` zero.
+    pub delta: bool,
+}
+
+/// What an area light sends towards rays that hit it, in sixteen lanes
+/// (`Light::emission_lanes`): `le` and `pdf_li` as the scalar functions give them.
+#[derive(Clone, Copy, Debug)]
+pub struct EmissionLanes {
+    /// Lanes whose point faces the ray (`le` is the radiance there, black elsewhere).
+    pub emits: Mask16,
+    pub radiance: V3<F32x16>,
+    /// `pdf_li` of each lane's point from its reference point.
+    pub pdf_li: F32x16,
 }
 
 /// From reference point `r` towards a light at `position`: (unit direction, distance,
@@ -433,8 +446,8 @@ impl Light {
     }
 
     /// `sample_li` for the lanes of `m` (reference points `r`, 2D samples `ux`, `uy`),
-    /// lane by lane the same bits; None for lights the lanes cannot sample (all but area
-    /// lights on meshes without vertex normals).
+    /// lane by lane the same bits; None for lights the lanes cannot sample (all but point
+    /// lights and area lights on meshes without vertex normals).
     #[inline]
     pub fn sample_li_lanes(
         &self,
@@ -443,18 +456,43 @@ impl Light {
         uy: F32x16,
         m: Mask16,
     ) -> Option<LightSampleLanes> {
+        let mut s = match self {
+            Light::Area(l) => l.sample_li_lanes(r, ux, uy, m)?,
+            Light::Point(l) => l.sample_li_lanes(r, m),
+            _ => return None,
+        };
+        // The checks of `sample_li`.
+        let zero = F32x16::splat(0.0);
+        let valid = |c: F32x16| c.is_finite() & c.ge(zero);
+        s.ok &= valid(s.radiance.x) & valid(s.radiance.y) & valid(s.radiance.z);
+        if !s.pdf_area.is_finite() {
+            s.ok = Mask16::NONE;
+        }
+        s.ok &= s.pdf_solid_angle.gt(zero) & s.pdf_solid_angle.is_finite() & s.wi.is_finite();
+        Some(s)
+    }
+
+    /// For rays that hit this light at points `p` (geometric normal `n`, emitting side
+    /// `front`) travelling towards `w` (unit, away from the light), from reference points
+    /// `r`: `le` and `pdf_li` (Light's cleaning included), lane by lane the same bits as the
+    /// scalar functions; None for lights the lanes cannot do (all but area lights on meshes
+    /// and disks).
+    #[inline]
+    pub fn emission_lanes(
+        &self,
+        p: V3<F32x16>,
+        n: V3<F32x16>,
+        front: V3<F32x16>,
+        w: V3<F32x16>,
+        r: V3<F32x16>,
+    ) -> Option<EmissionLanes> {
         let Light::Area(l) = self else {
             return None;
         };
-        let mut s = l.sample_li_lanes(r, ux, uy, m)?;
-        // The checks of `sample_li`.
-        if !(l.radiance.is_valid_radiance() && s.pdf_area.is_finite()) {
-            s.ok = Mask16::NONE;
-        }
-        s.ok &= s.pdf_solid_angle.gt(F32x16::splat(0.0))
-            & s.pdf_solid_angle.is_finite()
-            & s.wi.is_finite();
-        Some(s)
+        let mut e = l.emission_lanes(p, n, front, w, r)?;
+        let zero = F32x16::splat(0.0);
+        e.pdf_li = F32x16::select(e.pdf_li.is_finite() & e.pdf_li.gt(zero), e.pdf_li, zero);
+        Some(e)
     }
 
     /// Solid-angle density of `sample_li(ref_point, ·)` producing `hit` (0 for delta lights).

@@ -2,7 +2,8 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::light::{EmissionSample, LightSample, towards_point};
+use crate::light::{EmissionSample, LightSample, LightSampleLanes, towards_point};
+use crate::math::lanes::{F32x16, Mask16, V3};
 use crate::math::{PI, Rgb, warp};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -38,6 +39,30 @@ impl PointLight {
     }
 
     /// A uniform direction on the sphere (pdf 1/4π) from the light's position.
+    /// `sample_li` for the lanes of `m` (reference points `r`), lane by lane the same bits.
+    #[inline]
+    pub fn sample_li_lanes(&self, r: V3<F32x16>, m: Mask16) -> LightSampleLanes {
+        let c = F32x16::splat;
+        let zero = V3::new(c(0.0), c(0.0), c(0.0));
+        let position = V3::new(c(self.position.x), c(self.position.y), c(self.position.z));
+        // `towards_point`.
+        let d = position - r;
+        let dist2 = d.length_squared();
+        let dist = dist2.sqrt();
+        let i = self.intensity;
+        LightSampleLanes {
+            ok: m & dist2.gt(c(0.0)) & dist2.is_finite(),
+            p: position,
+            n: zero,
+            p_error: zero,
+            wi: d.div_scalar(dist),
+            radiance: V3::new(c(i.r()) / dist2, c(i.g()) / dist2, c(i.b()) / dist2),
+            pdf_solid_angle: c(1.0),
+            pdf_area: 1.0,
+            delta: true,
+        }
+    }
+
     pub fn sample_le(&self, u2: Vec2) -> Option<EmissionSample> {
         Some(EmissionSample {
             origin: self.position,

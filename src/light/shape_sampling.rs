@@ -144,6 +144,17 @@ impl ShapeSampler {
         })
     }
 
+    /// `pdf_from` for sixteen lanes, lane by lane the same bits; None for spheres (their
+    /// cone density is not done in lanes).
+    #[inline]
+    pub fn pdf_from_lanes(&self, r: V3<F32x16>, p: V3<F32x16>, n: V3<F32x16>) -> Option<F32x16> {
+        if let ShapeSampler::Sphere(_) = self {
+            return None;
+        }
+        let pdf = area_to_solid_angle_in(F32x16::splat(1.0 / self.area()), r, p, n);
+        Some(F32x16::select(pdf.is_finite(), pdf, F32x16::splat(0.0)))
+    }
+
     /// The solid-angle density with which `sample_from(r, ·)` produces point `p` (normal
     /// `n`) of this shape; 0 where that density is not finite.
     pub fn pdf_from(&self, r: Vec3, p: Vec3, n: Vec3) -> f32 {

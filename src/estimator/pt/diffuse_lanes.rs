@@ -77,6 +77,9 @@ impl NeeLanes {
                 Some(s) => {
                     out.ok |= s.ok;
                     out.finite |= same;
+                    if s.delta {
+                        out.delta |= same;
+                    }
                     out.p = V3::select(same, s.p, out.p);
                     out.n = V3::select(same, s.n, out.n);
                     out.p_error = V3::select(same, s.p_error, out.p_error);
@@ -127,7 +130,7 @@ fn min_num(a: F32x16, b: F32x16) -> F32x16 {
 /// `power_heuristic(a, b)` per lane: the f32 formula in lanes, and the scalar function
 /// for the rare lanes where it overflows.
 #[inline(always)]
-fn power_heuristic_lanes(pdf_a: F32x16, pdf_b: F32x16, m: Mask16) -> F32x16 {
+pub(super) fn power_heuristic_lanes(pdf_a: F32x16, pdf_b: F32x16, m: Mask16) -> F32x16 {
     let a = pdf_a * pdf_a;
     let b = pdf_b * pdf_b;
     let sum = a + b;

@@ -18,6 +18,7 @@ use glam::Vec2;
 
 use super::PathSample;
 use super::PathState;
+use super::diffuse_lanes::power_heuristic_lanes;
 use super::hit_lanes::HitLanes;
 use super::lane_scene::NO_LIGHT;
 use super::path_lanes::PathLanes;
@@ -25,8 +26,9 @@ use super::shadow_queue::ShadowQueue;
 use crate::camera::raster_in_pixel_lanes;
 use crate::estimator::camera_pass::{PassContext, PassCounts, start_camera_sample};
 use crate::film::{FilmTile, PixelRect};
+use crate::geometry::packet::RayLanes;
 use crate::math::Rgb;
-use crate::math::lanes::{LANES, Mask16, U32x16};
+use crate::math::lanes::{F32x16, LANES, Mask16, U32x16};
 use crate::sampler::IndependentSampler;
 use crate::sampler::pixel_samples::PixelSamples;
 use crate::scene::Scene;
@@ -216,6 +218,67 @@ impl PathSample {
         lanes.put(lane, state);
     }
 
+    /// The emission `arrive` adds for the lanes of `emitter` (hitting the area light
+    /// `light` of their shape, emitters shown): computed in lanes and queued in order with
+    /// the shadow rays (`ShadowQueue`, a term without a ray). Returns the lanes left to the
+    /// scalar code (lights whose emission is not done in lanes).
+    fn emission_in_lanes(
+        &self,
+        scene: &Scene,
+        lanes: &PathLanes,
+        hits: &HitLanes,
+        light: U32x16,
+        emitter: Mask16,
+        shadows: &mut ShadowQueue,
+    ) -> Mask16 {
+        let mut scalar = Mask16::NONE;
+        let towards_camera = -lanes.direction.normalize();
+        let chosen = light.to_array();
+        let mut todo = emitter;
+        while let Some(first) = todo.lanes().next() {
+            let same = todo & light.eq(U32x16::splat(chosen[first]));
+            todo &= !same;
+            let index = chosen[first] as usize;
+            let Some(e) = scene.lights.get(index).emission_lanes(
+                hits.p,
+                hits.ng,
+                hits.ns,
+                towards_camera,
+                lanes.prev_p,
+            ) else {
+                scalar |= same;
+                continue;
+            };
+            // `arrive` adds nothing where `le` is black: behind the light, or a light of
+            // zero radiance.
+            let zero = F32x16::splat(0.0);
+            let black = e.radiance.x.eq(zero) & e.radiance.y.eq(zero) & e.radiance.z.eq(zero);
+            let adds = same & e.emits & !black;
+            // `emission_weight`: 1 after a camera ray or a delta component, else the power
+            // heuristic against choosing this light and sampling the point.
+            let pdf_light = F32x16::splat(scene.lights.pmf(index)) * e.pdf_li;
+            let weight = F32x16::select(
+                lanes.prev_specular,
+                F32x16::splat(1.0),
+                power_heuristic_lanes(lanes.prev_pdf, pdf_light, adds & !lanes.prev_specular),
+            );
+            let term = lanes.throughput.mul_v(e.radiance) * weight;
+            let no_ray = RayLanes {
+                o: lanes.origin,
+                d: lanes.direction,
+                t_max: zero,
+            };
+            shadows.push(
+                adds,
+                &no_ray,
+                &term,
+                &term,
+                U32x16::from_array(lanes.sample),
+            );
+        }
+        scalar
+    }
+
     /// Advances every live lane by one vertex; lanes whose path ends write it to `queue`.
     fn advance_lanes(
         &self,
@@ -238,10 +301,12 @@ impl PathSample {
         hits.trace(scene, lanes);
         lanes.rays = lanes.rays + U32x16::select(live, one, zero);
 
-        // Arriving (`arrive`): escaped rays and emitters seen by the scalar code; the other
-        // lanes only check the depth.
+        // Arriving (`arrive`): emission found by the rays, in lanes for area lights on
+        // meshes and disks; escaped rays and other emitters by the scalar code. Every hit
+        // lane then checks the depth.
         let light = U32x16::gather(&tables.light, hits.shape, hits.hit);
         let emitter = hits.hit & !light.eq(U32x16::splat(NO_LIGHT)) & lanes.shows_emitters;
+        let scalar_emitters = self.emission_in_lanes(scene, lanes, hits, light, emitter, shadows);
         // An escaped ray ends the path; only the environment's lights add to it.
         let escaped = live & !hits.hit;
         let mut ended = escaped;
@@ -250,7 +315,7 @@ impl PathSample {
         } else {
             escaped & lanes.shows_environment
         };
-        for lane in (sees_environment | emitter).lanes() {
+        for lane in (sees_environment | scalar_emitters).lanes() {
             let mut state = self.take_path(scene, lanes, lane, queue, shadows);
             if !self.arrive(scene, &mut state, hits.interaction(scene, lane).as_ref()) {
                 ended.set(lane, true);
@@ -258,7 +323,7 @@ impl PathSample {
             Self::give_back(lanes, lane, &state, queue);
         }
         let deep = !(lanes.depth + one).lt(U32x16::splat(self.max_depth()));
-        ended |= hits.hit & !emitter & deep;
+        ended |= hits.hit & !scalar_emitters & deep;
 
         // Scattering: diffuse surfaces in lanes, the others one by one.
         let going = live & !ended;
