@@ -47,6 +47,7 @@ use glam::{Vec2, Vec3};
 use crate::geometry::Ray;
 use crate::geometry::packet::RayLanes;
 use crate::math::lanes::{F32x16, Real, U32x16, V3};
+use crate::math::warp::disk_concentric;
 use crate::scene::{FovAxis, SensorDesc};
 
 /// A pinhole (`<sensor type="perspective">`) or thin-lens (`<sensor type="thinlens">`)
@@ -208,30 +209,46 @@ impl Camera {
         )
     }
 
-    /// `generate_ray` for sixteen raster positions (x, y per lane), lane by lane the same
-    /// bits; only for a pinhole camera (None with a lens).
-    pub fn generate_ray_lanes(&self, x: F32x16, y: F32x16) -> Option<RayLanes> {
-        if self.lens.is_some() {
-            return None;
-        }
-        let d_camera = self.camera_direction_in(x, y).normalize();
+    /// `sample_ray` for sixteen raster positions (x, y) and lens samples (per lane), lane
+    /// by lane the same bits (`generate_ray` for a pinhole, which ignores `lens`).
+    pub fn sample_ray_lanes(&self, x: F32x16, y: F32x16, lens: (F32x16, F32x16)) -> RayLanes {
+        let c = F32x16::splat;
+        let on_plane = self.camera_direction_in(x, y);
         let m = &self.to_world.matrix;
-        // `Mat4::transform_vector3`: x_axis·v.x + y_axis·v.y + z_axis·v.z, per row.
-        let row = |k: usize| {
-            let c = |v: glam::Vec4| F32x16::splat(v[k]);
-            c(m.x_axis) * d_camera.x + c(m.y_axis) * d_camera.y + c(m.z_axis) * d_camera.z
+        // `Mat4::transform_vector3` / `transform_point3`: x_axis·v.x + y_axis·v.y +
+        // z_axis·v.z (+ w_axis), row by row.
+        let transform = |v: V3<F32x16>, point: bool| {
+            let row = |k: usize| {
+                let a = |col: glam::Vec4| c(col[k]);
+                let sum = a(m.x_axis) * v.x + a(m.y_axis) * v.y + a(m.z_axis) * v.z;
+                if point { sum + a(m.w_axis) } else { sum }
+            };
+            V3::new(row(0), row(1), row(2))
         };
-        let d = V3::new(row(0), row(1), row(2)).normalize();
-        let inv_z = F32x16::splat(1.0) / d_camera.z;
-        let near_t = F32x16::splat(self.near_clip) * inv_z;
-        let far_t = F32x16::splat(self.far_clip) * inv_z;
-        let p = self.position;
-        let origin = V3::new(F32x16::splat(p.x), F32x16::splat(p.y), F32x16::splat(p.z));
-        Some(RayLanes {
+        let (origin, d_camera) = match &self.lens {
+            None => {
+                let p = self.position;
+                (V3::new(c(p.x), c(p.y), c(p.z)), on_plane.normalize())
+            }
+            Some(thin) => {
+                // `ThinLens::point` and `ThinLens::direction`.
+                let (dx, dy) = disk_concentric(lens.0, lens.1);
+                let r = c(thin.radius());
+                let a = V3::new(r * dx, r * dy, c(0.0));
+                let d = (on_plane * c(thin.focus_distance()) - a).normalize();
+                (transform(a, true), d)
+            }
+        };
+        // `clipped_ray`.
+        let d = transform(d_camera, false).normalize();
+        let inv_z = c(1.0) / d_camera.z;
+        let near_t = c(self.near_clip) * inv_z;
+        let far_t = c(self.far_clip) * inv_z;
+        RayLanes {
             o: origin + d * near_t,
             d,
             t_max: far_t - near_t,
-        })
+        }
     }
 
     /// The primary ray through raster position `raster` (continuous pixel coordinates:

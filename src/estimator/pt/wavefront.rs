@@ -113,11 +113,10 @@ impl PathSample {
         let mut hits = HitLanes::default();
         let mut next = 0usize;
         let mut sampler = pass.camera_sampler();
-        // Camera samples start in lanes where they can: independent pixel samples, a
-        // pinhole camera, paths of at least one segment.
-        let start_in_lanes = matches!(**pass.pixel_samples, PixelSamples::Independent)
-            && !pass.scene.camera.has_lens()
-            && self.max_depth() > 0;
+        // Camera samples start in lanes where they can: independent pixel (and lens)
+        // samples, paths of at least one segment.
+        let start_in_lanes =
+            matches!(**pass.pixel_samples, PixelSamples::Independent) && self.max_depth() > 0;
         loop {
             if start_in_lanes {
                 next = self.start_in_lanes(pass, &mut lanes, queue, next);
@@ -175,13 +174,16 @@ impl PathSample {
         lanes
             .streams
             .start_pixel_samples(m, pass.seed, x, y, U32x16::from_array(index));
+        // The pixel sample, then (for a lens only) the lens sample: `start_camera_sample`.
+        let camera = &pass.scene.camera;
         let (ux, uy) = lanes.streams.next_2d(m);
         let (rx, ry) = raster_in_pixel_lanes(x, y, ux, uy);
-        let rays = pass
-            .scene
-            .camera
-            .generate_ray_lanes(rx, ry)
-            .expect("lanes start camera samples only for a pinhole");
+        let lens = if camera.has_lens() {
+            lanes.streams.next_2d(m)
+        } else {
+            (F32x16::splat(0.0), F32x16::splat(0.0))
+        };
+        let rays = camera.sample_ray_lanes(rx, ry, lens);
         lanes.start(m, &rays, self.settings.hide_emitters);
         let (rx, ry) = (rx.to_array(), ry.to_array());
         for lane in m.lanes() {
