@@ -525,6 +525,37 @@ impl Film {
         }
     }
 
+    /// Adds `value` at raster position `raster` through the filter as a camera sample's, but
+    /// without the sample's own filter weight: for images of parts of a camera sample's
+    /// value (one strategy's), whose pixels divide by the weights of the film that took the
+    /// whole samples (`image_normalized_by`). Non-finite values are dropped and counted.
+    pub fn add_value(&mut self, raster: Vec2, value: Rgb) {
+        if !is_finite(value) || !raster.is_finite() {
+            self.invalid_samples += 1;
+            return;
+        }
+        let (x, y) = (raster.x as f64, raster.y as f64);
+        let Some((x0, x1)) = clip(self.filter.footprint(x), 0, self.width as i64) else {
+            return;
+        };
+        let Some((y0, y1)) = clip(self.filter.footprint(y), 0, self.height as i64) else {
+            return;
+        };
+        weights_1d(&self.filter, x, x0, x1, &mut self.scratch_x);
+        weights_1d(&self.filter, y, y0, y1, &mut self.scratch_y);
+        let v = value.0.map(f64::from);
+        for (j, &wy) in (y0..=y1).zip(&self.scratch_y) {
+            let row = j as usize * self.width as usize;
+            for (i, &wx) in (x0..=x1).zip(&self.scratch_x) {
+                let w = wx * wy;
+                let s = &mut self.sums[row + i as usize];
+                for k in 0..3 {
+                    s[k] += w * v[k];
+                }
+            }
+        }
+    }
+
     /// Adds the splats of one piece of work, in the order they were recorded.
     pub fn merge_splats(&mut self, splats: &SplatList) {
         for &(raster, value) in &splats.entries {
@@ -576,11 +607,19 @@ impl Film {
     }
 
     pub fn image(&self, splat_scale: f64) -> Image {
+        self.image_normalized_by(self, splat_scale)
+    }
+
+    /// `image` with the pixel values (`add_value`'s) divided by the filter weights of
+    /// `samples`, a film of the same size that took the camera samples whole.
+    pub fn image_normalized_by(&self, samples: &Film, splat_scale: f64) -> Image {
+        debug_assert_eq!(self.sums.len(), samples.sums.len());
         let mut image = Image::new(self.width, self.height);
         for j in 0..self.height as usize {
             for i in 0..self.width as usize {
                 let p = j * self.width as usize + i;
-                let [r, g, b, w] = self.sums[p];
+                let [r, g, b, _] = self.sums[p];
+                let w = samples.sums[p][3];
                 let inv_w = if w != 0.0 { 1.0 / w } else { 0.0 };
                 let s = self.splats[p];
                 let splat_w = if s == [0.0; 3] {

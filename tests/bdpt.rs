@@ -149,27 +149,19 @@ fn leaning_vertex_normals_give_what_pt_gives() {
 }
 
 #[test]
-fn lights_at_infinity_are_refused_naming_the_scene() {
-    let scene = scene(&format!(
-        r#"<scene version="3.0.0">{camera}{floor}
-            <emitter type="constant"><rgb name="radiance" value="1"/></emitter>
-        </scene>"#,
-        camera = floor_camera(),
-        floor = floor(0.5)
-    ));
-    let err = estimator::create("bdpt", &Params::default(), &scene, 1)
-        .err()
-        .expect("refused")
-        .to_string();
-    assert!(
-        err.contains("test-scene.xml") && err.contains("infinity"),
-        "{err}"
-    );
-    let err = estimator::create("bdpt", &Params::parse(&["mis=other"]).unwrap(), &scene, 1)
-        .err()
-        .expect("refused")
-        .to_string();
-    assert!(err.contains("mis=other"), "{err}");
+fn unknown_parameter_values_are_refused_naming_them() {
+    let scene = shipped_scene("cbox.xml", 8);
+    for (params, expected) in [
+        (&["mis=other"][..], "mis=other"),
+        (&["strategies_max_depth=0"][..], "strategies_max_depth=0"),
+        (&["strategies_max_depth=99"][..], "strategies_max_depth=99"),
+    ] {
+        let err = estimator::create("bdpt", &Params::parse(params).unwrap(), &scene, 1)
+            .err()
+            .expect("refused")
+            .to_string();
+        assert!(err.contains(expected), "{err}");
+    }
 }
 
 #[test]

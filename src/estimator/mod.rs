@@ -48,6 +48,11 @@ pub trait Estimator: Send {
     /// The current estimate of radiance per pixel.
     fn image(&self) -> Image;
     fn stats(&self) -> Stats;
+    /// One image per bidirectional strategy (s, t), for estimators that keep them
+    /// (`bdpt` with `strategies=true`).
+    fn strategy_images(&self) -> Option<Vec<bdpt::StrategyImage>> {
+        None
+    }
 }
 
 /// Names of the estimators this build knows, for `--help` and error messages.

@@ -1,4 +1,5 @@
-//! Multiple importance sampling weights (Veach 1997, §9.2).
+//! Multiple importance sampling weights (Veach 1997, §9.2), for two strategies and for all
+//! the ways (s, t) a bidirectional estimator can make a path (Veach 1997, §10.3).
 
 /// Power heuristic with β = 2 for a sample drawn by strategy *a*, when strategy *b* could
 /// have drawn it too (Veach 1997, eq. 9.13): p_a² / (p_a² + p_b²). The densities must be in
@@ -34,6 +35,177 @@ pub fn balance_heuristic(pdf_a: f32, pdf_b: f32) -> f32 {
     // The sum overflows f32 when both densities are near its limit.
     let w = (pdf_a as f64 / (pdf_a as f64 + pdf_b as f64)) as f32;
     if w.is_finite() { w } else { 0.0 }
+}
+
+/// Which heuristic weighs the strategies of a path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Heuristic {
+    /// p_s / Σ p_j (Veach 1997, eq. 9.10).
+    Balance,
+    /// p_s² / Σ p_j² (Veach 1997, eq. 9.13 with β = 2).
+    Power,
+}
+
+/// One vertex of a complete path x0 … xk (x0 on a light, xk on the camera) as the weights
+/// of its strategies see it: its densities when the light subpath makes it and when the
+/// camera subpath does (`path::vertex` gives the measures), and whether a connection may
+/// end at it.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PathDensity {
+    /// x0: the light's origin density (choice of the light included); xi: the density of
+    /// sampling it from x(i−1).
+    pub from_light: f32,
+    /// The density of sampling it from x(i+1) (unused for xk).
+    pub from_camera: f32,
+    /// A connection may end here: not a surface the path crossed through a delta
+    /// component.
+    pub connectible: bool,
+}
+
+/// Which strategies an estimator uses, beyond what the path's delta vertices allow.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StrategyRules {
+    pub heuristic: Heuristic,
+    /// The emitter seen directly is left out (paths of one segment count for no strategy).
+    pub hide_emitters: bool,
+    /// A camera subpath can hit x0: false for point, spot and directional lights.
+    pub light_hittable: bool,
+    /// Light tracing's s = 1, t = 1 strategy (the light point joined to the camera) can
+    /// make the path: false for lights at infinity and delta lights, which the camera
+    /// never sees.
+    pub light_seen_by_camera: bool,
+}
+
+impl StrategyRules {
+    /// True when strategy s (s light vertices, t = k + 1 − s camera vertices, t ≥ 1) can
+    /// make a path of `path.len()` vertices.
+    fn can_make(&self, path: &[PathDensity], s: usize) -> bool {
+        let n = path.len();
+        debug_assert!(s < n, "strategies keep at least one camera vertex");
+        if n == 2 && self.hide_emitters {
+            return false;
+        }
+        match s {
+            0 => self.light_hittable,
+            _ => {
+                path[s - 1].connectible
+                    && path[s].connectible
+                    && !(n == 2 && s == 1 && !self.light_seen_by_camera)
+            }
+        }
+    }
+}
+
+/// The weight of strategy `s` (s light vertices) for the complete path `path`, over every
+/// strategy t ≥ 1 that `rules` allows: h(p_s) / Σ_j h(p_j) with p_j the density with which
+/// strategy j makes the path (Veach 1997, eq. 10.9). Only ratios are needed:
+/// p_(j−1)/p_j = from_camera(x(j−1)) / from_light(x(j−1)) (eq. 10.10). The ratios are
+/// products over the path, kept in a scaled f64 so that neither overflow nor underflow
+/// of a partial product changes a weight; 0 when strategy s could not have made the path.
+pub fn strategy_weight(path: &[PathDensity], s: usize, rules: &StrategyRules) -> f32 {
+    let n = path.len();
+    if s >= n || !rules.can_make(path, s) {
+        return 0.0;
+    }
+    let h = |r: ScaledRatio| match rules.heuristic {
+        Heuristic::Balance => r.value(),
+        Heuristic::Power => r.squared_value(),
+    };
+    let mut sum = 1.0f64;
+    // Strategies with fewer light vertices: x(j) moves to the camera side.
+    let mut ratio = ScaledRatio::ONE;
+    for j in (0..s).rev() {
+        ratio = ratio.times(path[j].from_camera, path[j].from_light);
+        if ratio.is_infinite() {
+            return 0.0;
+        }
+        if ratio.is_zero() {
+            break;
+        }
+        if rules.can_make(path, j) {
+            sum += h(ratio);
+        }
+    }
+    // Strategies with more light vertices: x(j − 1) moves to the light side.
+    let mut ratio = ScaledRatio::ONE;
+    for j in s + 1..n {
+        ratio = ratio.times(path[j - 1].from_light, path[j - 1].from_camera);
+        if ratio.is_infinite() {
+            return 0.0;
+        }
+        if ratio.is_zero() {
+            break;
+        }
+        if rules.can_make(path, j) {
+            sum += h(ratio);
+        }
+    }
+    let w = 1.0 / sum;
+    if w.is_finite() { w as f32 } else { 0.0 }
+}
+
+/// A non-negative ratio m·2^e with m kept in [2⁻²⁵⁶, 2²⁵⁶]: a product of path densities
+/// that no f64 overflow or underflow cuts short. Infinite once a factor is (a density of 0
+/// in a denominator: the other strategy's density has no finite ratio to ours); zero stays
+/// zero (every later strategy needs the density that was 0).
+#[derive(Clone, Copy, Debug)]
+struct ScaledRatio {
+    m: f64,
+    e: i32,
+}
+
+impl ScaledRatio {
+    const ONE: ScaledRatio = ScaledRatio { m: 1.0, e: 0 };
+    /// 2²⁵⁶.
+    const LIMIT: f64 = 1.157_920_892_373_162e77;
+
+    /// self × num / den.
+    fn times(self, num: f32, den: f32) -> ScaledRatio {
+        if num == 0.0 {
+            return ScaledRatio { m: 0.0, e: 0 };
+        }
+        let factor = num as f64 / den as f64;
+        if !factor.is_finite() {
+            return ScaledRatio {
+                m: f64::INFINITY,
+                e: self.e,
+            };
+        }
+        let (mut m, mut e) = (self.m * factor, self.e);
+        while m > Self::LIMIT {
+            m /= Self::LIMIT;
+            e += 256;
+        }
+        while m != 0.0 && m < 1.0 / Self::LIMIT {
+            m *= Self::LIMIT;
+            e -= 256;
+        }
+        ScaledRatio { m, e }
+    }
+
+    fn is_zero(self) -> bool {
+        self.m == 0.0
+    }
+
+    fn is_infinite(self) -> bool {
+        self.m.is_infinite()
+    }
+
+    /// The ratio as an f64 (∞ or 0 only where it leaves f64's range).
+    fn value(self) -> f64 {
+        times_power_of_two(self.m, self.e)
+    }
+
+    /// The squared ratio as an f64.
+    fn squared_value(self) -> f64 {
+        times_power_of_two(self.m * self.m, 2 * self.e)
+    }
+}
+
+/// m·2^e in two steps, so that 2^e alone does not overflow where the product would not.
+fn times_power_of_two(m: f64, e: i32) -> f64 {
+    let half = e / 2;
+    m * 2f64.powi(half) * 2f64.powi(e - half)
 }
 
 #[cfg(test)]

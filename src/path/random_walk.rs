@@ -34,12 +34,26 @@ pub struct WalkLimits {
     pub rr_depth: u32,
 }
 
-/// Extends `path`, whose last vertex (the camera or a light) sent `ray` with solid-angle
-/// density `pdf_dir` and left throughput `beta`, by the surfaces the walk meets: each new
-/// vertex gets its forward density (area measure) and gives the one before it its reverse
-/// density. `mode` is the quantity carried: radiance from the camera, importance from a
-/// light (with the adjoint's shading-normal factor, Veach 1997, eq. 5.19). Returns the
-/// rays cast.
+/// Extends `path`, whose last vertex (the camera or a light) sent `ray` with density
+/// `pdf_dir` (solid angle; per unit area of the emission disk from a vertex at infinity)
+/// and left throughput `beta`, by the surfaces the walk meets: each new vertex gets its
+/// forward density (`Vertex::to_area`) and gives the one before it its reverse density.
+/// `mode` is the quantity carried: radiance from the camera, importance from a light (with
+/// the adjoint's shading-normal factor, Veach 1997, eq. 5.19). A camera walk (radiance)
+/// that escapes a scene with an environment (`constant`, `envmap`) ends with a vertex at
+/// infinity in the escaped direction. Returns the rays cast.
+///
+/// A delta (specular) sample gets densities that make the ratios between strategies right
+/// (Veach 1997, §10.3.5; derived in the README's Design section). In projected solid angle
+/// the Dirac deltas of the two directions through a specular vertex differ only by the
+/// squared indices of refraction on either side (conservation of étendue,
+/// η_i² cos θ_i dω_i = η_t² cos θ_t dω_t), so with the delta itself factored out, the
+/// forward density is P·η_t/η_i and the reverse P·η_i/η_t, P being the probability of
+/// choosing the component (the same both ways for every delta component mltbench has: a
+/// mirror keeps |cos θ|, and Fresnel reflectance is the same from either side). As
+/// solid-angle densities, the form `to_area` converts: P·(η_t/η_i)·|cos θ_t| forward and
+/// P·(η_i/η_t)·|cos θ_i| back, the cosines taken in the shading frame the component
+/// reflects or refracts in.
 #[allow(clippy::too_many_arguments)]
 pub fn random_walk<'a>(
     scene: &'a Scene,
@@ -58,6 +72,11 @@ pub fn random_walk<'a>(
     while bounces < limits.max_vertices {
         rays += 1;
         let Some(si) = scene.geometry.intersect(&ray) else {
+            if mode == TransportMode::Radiance && !scene.lights.environment().is_empty() {
+                let mut vertex = Vertex::at_infinity(None, false, ray.d.normalize(), beta);
+                vertex.pdf_fwd = pdf_fwd;
+                path.push(vertex);
+            }
             break;
         };
         let wo = -ray.d.normalize();
@@ -86,9 +105,12 @@ pub fn random_walk<'a>(
         if mode == TransportMode::Importance {
             weight *= adjoint_shading_factor(wo, wi, si.ns, si.ng);
         }
-        // Delta samples have no density either way (Veach 1997, §10.3.5).
         let (fwd, rev) = if bs.delta {
-            (0.0, 0.0)
+            // Projected-solid-angle densities P·η_t/η_i and P·η_i/η_t, as solid angle.
+            (
+                bs.pdf * bs.eta * bs.wi.z.abs(),
+                bs.pdf / bs.eta * wo_local.z.abs(),
+            )
         } else {
             (bs.pdf, bsdf.pdf(bs.wi, wo_local))
         };

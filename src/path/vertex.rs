@@ -1,9 +1,9 @@
-//! Path vertices and the densities bidirectional estimators weigh them by (DESIGN.md §2).
+//! Path vertices and the densities bidirectional estimators weigh them by.
 //!
 //! A subpath is a list of vertices: the camera or a light first, then the surfaces its
-//! random walk met. Each vertex keeps the throughput β of the subpath up to it, and two
-//! densities in **area measure** (per unit area at the vertex; per unit solid angle where
-//! the vertex is a point, the pinhole or a point light, has no area):
+//! random walk met (and, for a camera subpath that escapes the scene, the environment in
+//! the direction it escaped). Each vertex keeps the throughput β of the subpath up to it,
+//! and two densities:
 //!
 //! * `pdf_fwd`: of the vertex being produced by its own subpath's sampling from the
 //!   previous vertex;
@@ -11,15 +11,24 @@
 //!   after it (filled in when the next vertex is sampled, and for the connection's
 //!   endpoints by the strategy that connects them).
 //!
-//! Multiple importance sampling over all ways (s, t) of cutting a path into a light and a
-//! camera subpath needs only these ratios (Veach 1997, §10.2–10.3). Delta (specular)
-//! vertices carry density 0 both ways: no strategy can connect at them.
+//! The measure is **area** at points of the scene (per unit area; at the pinhole or a point
+//! light, which have no area, the direction's density stands in), and **solid angle** at
+//! infinity (a vertex at infinity is a direction). A ray from infinity (a light at infinity
+//! emitting through the scene's bounding disk) gives the point it reaches the density of its
+//! disk point times the cosine there: the disk is perpendicular to the ray.
+//!
+//! A vertex whose subpath left it through a delta (specular) component has `delta` set: no
+//! strategy connects there, but its densities are real numbers, not zeros (see
+//! `random_walk` and the README's Design section: the density of a delta vertex in
+//! projected solid angle), so that the ratios between strategies keep every factor that
+//! does not cancel (Veach 1997, §10.3.5).
 
 use std::borrow::Cow;
 
 use glam::Vec3;
 
 use crate::geometry::SurfaceInteraction;
+use crate::light::LightPoint;
 use crate::material::Bsdf;
 use crate::math::{Frame, Rgb};
 use crate::scene::Scene;
@@ -29,9 +38,15 @@ use crate::scene::Scene;
 pub enum VertexKind<'a> {
     /// The pinhole or a point of the lens.
     Camera,
-    /// A point of light `light` (index in the scene's `LightSet`); `delta_pos` for point
-    /// and spot lights.
-    Light { light: usize, delta_pos: bool },
+    /// A point of light `light` (index in the scene's `LightSet`) at a finite position;
+    /// `delta` for point and spot lights (no ray can hit them).
+    Light { light: usize, delta: bool },
+    /// A direction at infinity (`Vertex::p` is the unit direction from the scene towards
+    /// it): the start of a light subpath from light `light` (`directional`, `constant`,
+    /// `envmap`; `delta` for directional lights, which no ray can hit), or, with `light`
+    /// None, where a camera subpath escaped the scene: the environment, all of the scene's
+    /// `constant` and `envmap` emitters together.
+    Infinite { light: Option<usize>, delta: bool },
     /// A surface point with its BSDF and shading frame.
     Surface {
         si: SurfaceInteraction,
@@ -43,8 +58,10 @@ pub enum VertexKind<'a> {
 #[derive(Clone, Debug)]
 pub struct Vertex<'a> {
     pub kind: VertexKind<'a>,
+    /// The position; for a vertex at infinity the unit direction towards it.
     pub p: Vec3,
-    /// Geometric normal; zero for points without a surface (pinhole, point lights).
+    /// Geometric normal; zero for points without a surface (pinhole, point lights); for a
+    /// vertex at infinity −`p` (facing the scene).
     pub ng: Vec3,
     /// Throughput of the subpath up to and including this vertex's sampling density.
     pub beta: Rgb,
@@ -70,13 +87,29 @@ impl<'a> Vertex<'a> {
         }
     }
 
-    pub fn light(light: usize, delta_pos: bool, p: Vec3, ng: Vec3, beta: Rgb, pdf: f32) -> Self {
+    /// A point of light `light` at a finite position, with origin density `pdf`.
+    pub fn light(light: usize, delta: bool, p: Vec3, ng: Vec3, beta: Rgb, pdf: f32) -> Self {
         Vertex {
-            kind: VertexKind::Light { light, delta_pos },
+            kind: VertexKind::Light { light, delta },
             p,
             ng,
             beta,
             pdf_fwd: pdf,
+            pdf_rev: 0.0,
+            delta: false,
+            wo: Vec3::ZERO,
+        }
+    }
+
+    /// The direction `towards` at infinity: of light `light`, or (None) the environment a
+    /// camera subpath escaped to, with throughput `beta`.
+    pub fn at_infinity(light: Option<usize>, delta: bool, towards: Vec3, beta: Rgb) -> Self {
+        Vertex {
+            kind: VertexKind::Infinite { light, delta },
+            p: towards,
+            ng: -towards,
+            beta,
+            pdf_fwd: 0.0,
             pdf_rev: 0.0,
             delta: false,
             wo: Vec3::ZERO,
@@ -111,14 +144,21 @@ impl<'a> Vertex<'a> {
         }
     }
 
+    /// A light that no ray can hit: a point, spot or directional light.
     pub fn is_delta_light(&self) -> bool {
         matches!(
             self.kind,
-            VertexKind::Light {
-                delta_pos: true,
-                ..
-            }
+            VertexKind::Light { delta: true, .. } | VertexKind::Infinite { delta: true, .. }
         )
+    }
+
+    pub fn is_infinite(&self) -> bool {
+        matches!(self.kind, VertexKind::Infinite { .. })
+    }
+
+    /// A surface whose BSDF is the index-matched `null` boundary.
+    pub fn is_null_surface(&self) -> bool {
+        matches!(&self.kind, VertexKind::Surface { bsdf, .. } if bsdf.is_null())
     }
 
     /// The surface interaction of a surface vertex.
@@ -129,72 +169,137 @@ impl<'a> Vertex<'a> {
         }
     }
 
-    /// Converts a solid-angle density at this vertex, for the direction towards `next`,
-    /// to area measure at `next` (Veach 1997, eq. 8.10): × |cos θ_next| / d², the cosine
-    /// only where `next` lies on a surface.
-    pub fn to_area(&self, pdf_solid_angle: f32, next: &Vertex) -> f32 {
+    /// The unit direction from this vertex to `next` (either may be at infinity).
+    pub fn direction_to(&self, next: &Vertex) -> Vec3 {
+        if next.is_infinite() {
+            next.p
+        } else if self.is_infinite() {
+            -self.p
+        } else {
+            (next.p - self.p).normalize_or_zero()
+        }
+    }
+
+    /// Converts a density of the ray leaving this vertex towards `next` to `next`'s measure
+    /// (Veach 1997, eq. 8.10): a solid-angle density × |cos θ_next| / d² (the cosine only
+    /// where `next` lies on a surface); unchanged when `next` is at infinity (a direction);
+    /// from a vertex at infinity, whose rays are parallel, a density per unit area of the
+    /// emission disk × |cos θ_next|.
+    pub fn to_area(&self, pdf: f32, next: &Vertex) -> f32 {
+        if next.is_infinite() {
+            return pdf;
+        }
+        if self.is_infinite() {
+            let pdf = pdf * next.ng.dot(self.p).abs();
+            return if pdf.is_finite() { pdf } else { 0.0 };
+        }
         let d = next.p - self.p;
         let dist2 = d.length_squared();
         if dist2.is_nan() || dist2 <= 0.0 {
             return 0.0;
         }
-        let mut pdf = pdf_solid_angle / dist2;
+        let mut pdf = pdf / dist2;
         if next.ng != Vec3::ZERO {
             pdf *= next.ng.dot(d / dist2.sqrt()).abs();
         }
         if pdf.is_finite() { pdf } else { 0.0 }
     }
 
-    /// The area density at `next` with which this vertex's sampling produces it, given
-    /// that the subpath reached this vertex from `prev` (None for the camera or a light,
-    /// which need none): the BSDF's density for a surface, the camera's direction density,
-    /// a light's emission direction density.
+    /// The density in `next`'s measure with which this vertex's sampling produces it,
+    /// given that the subpath reached this vertex from `prev` (None for the camera or a
+    /// light, which need none): the BSDF's density for a surface, the camera's direction
+    /// density, a light's emission direction density, the emission disk's for a vertex at
+    /// infinity. Connections never end at a delta vertex, so this is only asked of
+    /// non-delta sampling.
     pub fn pdf(&self, scene: &Scene, prev: Option<&Vertex>, next: &Vertex) -> f32 {
-        let w = (next.p - self.p).normalize_or_zero();
+        let w = self.direction_to(next);
         let pdf = match &self.kind {
             VertexKind::Surface { bsdf, frame, .. } => {
                 let Some(prev) = prev else { return 0.0 };
-                let wp = (prev.p - self.p).normalize_or_zero();
+                let wp = self.direction_to(prev);
                 bsdf.pdf(frame.to_local(wp), frame.to_local(w))
             }
             VertexKind::Camera => scene.camera.pdf_direction_from(self.p, w),
             VertexKind::Light { light, .. } => {
                 scene.lights.get(*light).pdf_le(self.p, self.ng, w).1
             }
+            VertexKind::Infinite { .. } => scene.lights.sphere().disk_pdf(),
         };
         self.to_area(pdf, next)
     }
 
-    /// For a vertex on an emitter (a light vertex, or a camera-subpath surface vertex on an
-    /// area light): the area density with which a light subpath starts here, choice of the
-    /// light included. 0 when it is on no light.
-    pub fn pdf_light_origin(&self, scene: &Scene, towards: &Vertex) -> f32 {
+    /// For a vertex on an emitter (a light vertex, a camera-subpath surface vertex on an
+    /// area light, a direction at infinity): the density with which a light subpath starts
+    /// here, choice of the light included (area measure; solid angle at infinity). 0 when
+    /// it is on no light.
+    ///
+    /// At infinity the direction is what is sampled, and every `constant` and `envmap`
+    /// emitter could have sampled it: its density is Σ_j p_choose(j) p_dir,j(ω), the
+    /// environment taken as one emitter (a directional light's own direction is a delta:
+    /// its choice probability stands for it).
+    /// `w` is the unit direction the light subpath leaves in (unused at infinity).
+    pub fn pdf_light_origin(&self, scene: &Scene, w: Vec3) -> f32 {
+        let lights = &scene.lights;
+        if let VertexKind::Infinite { light, delta } = self.kind {
+            if delta {
+                return light.map_or(0.0, |l| lights.pmf(l));
+            }
+            let travel = -self.p;
+            return lights
+                .environment()
+                .iter()
+                .map(|&j| lights.pmf(j) * lights.get(j).pdf_le(Vec3::ZERO, travel, travel).1)
+                .sum();
+        }
         let Some(light) = self.light_index(scene) else {
             return 0.0;
         };
-        let w = (towards.p - self.p).normalize_or_zero();
-        scene.lights.pmf(light) * scene.lights.get(light).pdf_le(self.p, self.ng, w).0
+        lights.pmf(light) * lights.get(light).pdf_le(self.p, self.ng, w).0
     }
 
-    /// For a vertex on an emitter: the area density at `towards` of the light's emission
-    /// direction sampling.
+    /// For a vertex on an emitter: the density at `towards` (in its measure) of the light's
+    /// emission sampling.
     pub fn pdf_light_direction(&self, scene: &Scene, towards: &Vertex) -> f32 {
+        if self.is_infinite() {
+            return self.to_area(scene.lights.sphere().disk_pdf(), towards);
+        }
         let Some(light) = self.light_index(scene) else {
             return 0.0;
         };
-        let w = (towards.p - self.p).normalize_or_zero();
+        let w = self.direction_to(towards);
         self.to_area(
             scene.lights.get(light).pdf_le(self.p, self.ng, w).1,
             towards,
         )
     }
 
-    /// The light this vertex lies on, if any.
+    /// The light this vertex lies on, if any (None at infinity: see `pdf_light_origin`).
     pub fn light_index(&self, scene: &Scene) -> Option<usize> {
         match &self.kind {
             VertexKind::Light { light, .. } => Some(*light),
             VertexKind::Surface { si, .. } => scene.lights.light_of_shape(si.shape as usize),
-            VertexKind::Camera => None,
+            VertexKind::Camera | VertexKind::Infinite { .. } => None,
+        }
+    }
+
+    /// The radiance a camera subpath that ends here receives from an emitter: an area
+    /// light's towards `wo`, or the environment's along the escaped direction. Black
+    /// elsewhere.
+    pub fn emitted(&self, scene: &Scene) -> Rgb {
+        let lights = &scene.lights;
+        match &self.kind {
+            VertexKind::Surface { si, .. } => match lights.light_of_shape(si.shape as usize) {
+                Some(light) => lights.get(light).le(&LightPoint::from(si), self.wo),
+                None => Rgb::BLACK,
+            },
+            VertexKind::Infinite { light: None, .. } => {
+                let point = LightPoint::direction(self.p);
+                lights
+                    .environment()
+                    .iter()
+                    .fold(Rgb::BLACK, |sum, &j| sum + lights.get(j).le(&point, self.p))
+            }
+            _ => Rgb::BLACK,
         }
     }
 }

@@ -1,0 +1,343 @@
+//! One bidirectional strategy (s, t): joining the first s vertices of a light subpath
+//! y0 y1 … and the first t of a camera subpath z0 z1 … into a path of s + t vertices
+//! (Veach 1997, §10.2), its unweighted contribution, and its multiple-importance weight
+//! over every strategy that could have made the same path (§10.3).
+//!
+//! * s = 0: the camera subpath found an emitter (an area light, or the environment at
+//!   infinity);
+//! * s = 1: a point sampled on a light from z(t−1) (next-event estimation);
+//! * t = 1: y(s−1) joined to a camera point and splatted where it lands (light tracing);
+//! * otherwise y(s−1) and z(t−1) joined by a shadow ray.
+//!
+//! Point, spot and directional lights stay invisible to the camera, lights at infinity are
+//! never joined to it directly (only camera rays see them), and `hide_emitters` leaves out
+//! the emitter seen directly and the environment seen through `null` surfaces only, as in
+//! `pt`.
+
+use glam::{Vec2, Vec3};
+
+use crate::geometry::Ray;
+use crate::material::TransportMode;
+use crate::math::Rgb;
+use crate::path::camera_connection::{self, adjoint_shading_factor};
+use crate::path::mis::{Heuristic, PathDensity, StrategyRules, strategy_weight};
+use crate::path::subpath::LightStart;
+use crate::path::vertex::{Vertex, VertexKind};
+use crate::sampler::Sampler;
+use crate::scene::Scene;
+
+/// A strategy's endpoint sampled by the strategy itself (s = 1: a light point; t = 1: a
+/// camera point), standing in for the subpath's own first vertex.
+pub struct Sampled<'a> {
+    pub vertex: Vertex<'a>,
+    /// Light subpath side (s = 1) or camera side (t = 1).
+    pub light_side: bool,
+}
+
+/// One strategy's unweighted contribution, before its visibility test.
+pub struct Connection<'a> {
+    pub value: Rgb,
+    /// The segment that must be unoccluded for the contribution to count.
+    pub shadow: Option<Ray>,
+    /// The film position, for t = 1 (splatted); None for the camera sample's pixel.
+    pub raster: Option<Vec2>,
+    pub sampled: Option<Sampled<'a>>,
+}
+
+/// The unweighted contribution of strategy (s, t); None when it gives nothing. Draws a
+/// light choice and a light point for s = 1, a lens point for t = 1 with a thin lens.
+#[allow(clippy::too_many_arguments)]
+pub fn connect<'a>(
+    scene: &'a Scene,
+    light_path: &[Vertex<'a>],
+    camera_path: &[Vertex<'a>],
+    start: Option<&LightStart>,
+    s: usize,
+    t: usize,
+    hide_emitters: bool,
+    sampler: &mut impl Sampler,
+) -> Option<Connection<'a>> {
+    if s == 0 {
+        return emitter_found(scene, camera_path, t, hide_emitters);
+    }
+    if t == 1 {
+        return light_vertex_to_camera(scene, light_path, start, s, hide_emitters, sampler);
+    }
+    let pt = &camera_path[t - 1];
+    let VertexKind::Surface {
+        si: si_pt,
+        bsdf: bsdf_pt,
+        frame: frame_pt,
+    } = &pt.kind
+    else {
+        return None;
+    };
+    if !bsdf_pt.has_non_delta() {
+        return None;
+    }
+    if s == 1 {
+        // Next-event estimation from z(t−1).
+        let u_light = sampler.next_1d();
+        let u = sampler.next_2d();
+        let (index, pmf, _) = scene.lights.sample(u_light)?;
+        let light = scene.lights.get(index);
+        let ls = light.sample_li(si_pt.p, u)?;
+        let f = bsdf_pt.eval(
+            frame_pt.to_local(pt.wo),
+            frame_pt.to_local(ls.wi),
+            TransportMode::Radiance,
+        );
+        let cos = ls.wi.dot(si_pt.ns).abs();
+        let value = pt.beta * f * ls.radiance * (cos / (pmf * ls.pdf_solid_angle));
+        let (mut vertex, shadow) = if ls.dist.is_finite() {
+            (
+                Vertex::light(index, ls.delta, ls.p, ls.n, ls.radiance, 0.0),
+                si_pt.spawn_ray_to_surface(ls.p, ls.p_error, ls.n),
+            )
+        } else {
+            (
+                Vertex::at_infinity(Some(index), ls.delta, ls.wi, ls.radiance),
+                si_pt.spawn_ray(ls.wi),
+            )
+        };
+        vertex.pdf_fwd = vertex.pdf_light_origin(scene, -ls.wi);
+        return Some(Connection {
+            value,
+            shadow: Some(shadow),
+            raster: None,
+            sampled: Some(Sampled {
+                vertex,
+                light_side: true,
+            }),
+        });
+    }
+    let qs = &light_path[s - 1];
+    let VertexKind::Surface {
+        si: si_qs,
+        bsdf: bsdf_qs,
+        frame: frame_qs,
+    } = &qs.kind
+    else {
+        return None;
+    };
+    if !bsdf_qs.has_non_delta() {
+        return None;
+    }
+    let d = pt.p - qs.p;
+    let dist2 = d.length_squared();
+    if dist2.is_nan() || dist2 <= 0.0 {
+        return None;
+    }
+    let w = d / dist2.sqrt();
+    // f at the light vertex (importance, with the adjoint's shading-normal factor)
+    // and at the camera vertex, and G with shading-normal cosines (Veach 1997, §10.2).
+    let f_qs = bsdf_qs.eval(
+        frame_qs.to_local(qs.wo),
+        frame_qs.to_local(w),
+        TransportMode::Importance,
+    ) * adjoint_shading_factor(qs.wo, w, si_qs.ns, si_qs.ng);
+    let f_pt = bsdf_pt.eval(
+        frame_pt.to_local(pt.wo),
+        frame_pt.to_local(-w),
+        TransportMode::Radiance,
+    );
+    let g = w.dot(si_qs.ns).abs() * w.dot(si_pt.ns).abs() / dist2;
+    Some(Connection {
+        value: qs.beta * f_qs * f_pt * pt.beta * g,
+        shadow: Some(si_qs.spawn_ray_to_interaction(si_pt)),
+        raster: None,
+        sampled: None,
+    })
+}
+
+/// s = 0: z(t−1) lies on an area light or is the environment at infinity.
+fn emitter_found<'a>(
+    scene: &Scene,
+    camera_path: &[Vertex<'a>],
+    t: usize,
+    hide_emitters: bool,
+) -> Option<Connection<'a>> {
+    if hide_emitters {
+        // The emitter the camera ray hits first, and the environment behind `null`
+        // surfaces only (pt's rule, Mitsuba 3's).
+        let through_nulls_only = camera_path[1..t - 1].iter().all(Vertex::is_null_surface);
+        if t == 2 || (camera_path[t - 1].is_infinite() && through_nulls_only) {
+            return None;
+        }
+    }
+    let pt = &camera_path[t - 1];
+    let le = pt.emitted(scene);
+    if le.is_black() {
+        return None;
+    }
+    Some(Connection {
+        value: pt.beta * le,
+        shadow: None,
+        raster: None,
+        sampled: None,
+    })
+}
+
+/// t = 1: y(s−1) joined to a camera point (light tracing).
+fn light_vertex_to_camera<'a>(
+    scene: &'a Scene,
+    light_path: &[Vertex<'a>],
+    start: Option<&LightStart>,
+    s: usize,
+    hide_emitters: bool,
+    sampler: &mut impl Sampler,
+) -> Option<Connection<'a>> {
+    let qs = &light_path[s - 1];
+    if !qs.is_connectible() {
+        return None;
+    }
+    let u_lens = if scene.camera.has_lens() {
+        sampler.next_2d()
+    } else {
+        Vec2::ZERO
+    };
+    let splat = match &qs.kind {
+        VertexKind::Light { light, .. } => {
+            if hide_emitters {
+                return None;
+            }
+            let start = start?;
+            camera_connection::connect_emitter(
+                scene,
+                scene.lights.get(*light),
+                start.pmf,
+                &start.emission,
+                u_lens,
+            )?
+        }
+        VertexKind::Surface { si, bsdf, frame } => {
+            camera_connection::connect_surface(scene, si, frame, bsdf, qs.wo, qs.beta, u_lens)?
+        }
+        VertexKind::Infinite { .. } | VertexKind::Camera => return None,
+    };
+    Some(Connection {
+        value: splat.value,
+        shadow: Some(splat.shadow),
+        raster: Some(splat.raster),
+        sampled: Some(Sampled {
+            vertex: Vertex::camera(splat.camera_position, Vec3::ZERO),
+            light_side: false,
+        }),
+    })
+}
+
+/// Fills `out` with the densities of the complete path strategy (s, t) made (x0 … x(s+t−1),
+/// light to camera), the endpoints replaced by what the strategy sampled (`sampled`) and
+/// the densities the connection creates computed here; returns the strategy rules that
+/// the path's light imposes (with `heuristic` and `hide_emitters`).
+#[allow(clippy::too_many_arguments)]
+pub fn path_densities(
+    scene: &Scene,
+    light_path: &[Vertex],
+    camera_path: &[Vertex],
+    sampled: Option<&Sampled>,
+    s: usize,
+    t: usize,
+    heuristic: Heuristic,
+    hide_emitters: bool,
+    out: &mut Vec<PathDensity>,
+) -> StrategyRules {
+    // The strategy's endpoints as vertices (the sampled one where there is one).
+    let light_end = |i: usize| match sampled {
+        Some(Sampled {
+            vertex,
+            light_side: true,
+        }) if i == 0 => vertex,
+        _ => &light_path[i],
+    };
+    let camera_end = |i: usize| match sampled {
+        Some(Sampled {
+            vertex,
+            light_side: false,
+        }) if i == 0 => vertex,
+        _ => &camera_path[i],
+    };
+    let connectible = |v: &Vertex| !v.delta && v.is_connectible();
+    out.clear();
+    for i in 0..s {
+        let v = light_end(i);
+        out.push(PathDensity {
+            from_light: v.pdf_fwd,
+            from_camera: v.pdf_rev,
+            connectible: i == 0 || connectible(v),
+        });
+    }
+    for i in (0..t).rev() {
+        let v = camera_end(i);
+        out.push(PathDensity {
+            from_light: v.pdf_rev,
+            from_camera: v.pdf_fwd,
+            connectible: connectible(v),
+        });
+    }
+    // The connection's endpoints: whatever their walks sampled next, the path leaves them
+    // along the connection, through non-delta components.
+    let pt = camera_end(t - 1);
+    let pt_minus = (t >= 2).then(|| camera_end(t - 2));
+    let qs = (s >= 1).then(|| light_end(s - 1));
+    let qs_minus = (s >= 2).then(|| light_end(s - 2));
+    out[s].connectible = true;
+    if s >= 1 {
+        out[s - 1].connectible = true;
+    }
+    // The densities the connection creates: of pt from the light side, of pt_minus from
+    // pt; of qs from the camera side, of qs_minus from qs.
+    out[s].from_light = match qs {
+        Some(qs) => qs.pdf(scene, qs_minus, pt),
+        None => pt.pdf_light_origin(scene, pt.direction_to(pt_minus.expect("s = 0 has t ≥ 2"))),
+    };
+    if let Some(pt_minus) = pt_minus {
+        out[s + 1].from_light = match qs {
+            Some(qs) => pt.pdf(scene, Some(qs), pt_minus),
+            None => pt.pdf_light_direction(scene, pt_minus),
+        };
+    }
+    if let Some(qs) = qs {
+        out[s - 1].from_camera = pt.pdf(scene, pt_minus, qs);
+        if let Some(qs_minus) = qs_minus {
+            out[s - 2].from_camera = qs.pdf(scene, Some(pt), qs_minus);
+        }
+    }
+    let x0 = if s >= 1 { light_end(0) } else { pt };
+    let finite_area_light = matches!(x0.kind, VertexKind::Surface { .. })
+        || matches!(x0.kind, VertexKind::Light { delta: false, .. });
+    StrategyRules {
+        heuristic,
+        hide_emitters,
+        light_hittable: !x0.is_delta_light(),
+        light_seen_by_camera: finite_area_light,
+    }
+}
+
+/// The weight of strategy (s, t) for the path it made (`path_densities`, then
+/// `mis::strategy_weight`); `scratch` is reused between calls.
+#[allow(clippy::too_many_arguments)]
+pub fn weight(
+    scene: &Scene,
+    light_path: &[Vertex],
+    camera_path: &[Vertex],
+    sampled: Option<&Sampled>,
+    s: usize,
+    t: usize,
+    heuristic: Heuristic,
+    hide_emitters: bool,
+    scratch: &mut Vec<PathDensity>,
+) -> f32 {
+    let rules = path_densities(
+        scene,
+        light_path,
+        camera_path,
+        sampled,
+        s,
+        t,
+        heuristic,
+        hide_emitters,
+        scratch,
+    );
+    strategy_weight(scratch, s, &rules)
+}
