@@ -147,7 +147,10 @@ struct RenderArgs {
     #[arg(long, value_name = "SECONDS")]
     time: Option<f64>,
     /// Output EXR. Default: <scene name>.exr in the working directory. A PNG preview is
-    /// written beside it.
+    /// written beside it; with `bdpt --set strategies=true`, the strategy images go to the
+    /// folder OUT-strategies/ beside it (one EXR per strategy (s, t), weighted and
+    /// unweighted, the pyramid sheets pyramid-weighted.png and pyramid-unweighted.png, and
+    /// strategies.csv).
     #[arg(short, long, value_name = "OUT.exr")]
     output: Option<PathBuf>,
 }
@@ -218,6 +221,12 @@ fn run_render(args: RenderArgs) -> Result<bool> {
     let pool = thread_pool(args.common.threads)?;
     let mut estimator =
         estimator::create(&args.common.estimator, &params, &scene, args.common.seed)?;
+    let strategy_folder = estimator
+        .keeps_strategy_images()
+        .then(|| io::strategy_images::folder_for(&output));
+    if let Some(folder) = &strategy_folder {
+        io::strategy_images::prepare(folder)?;
+    }
 
     // From here on Ctrl-C (or SIGTERM) stops after the pass in progress and writes it.
     interrupt::install();
@@ -251,6 +260,15 @@ fn run_render(args: RenderArgs) -> Result<bool> {
 
     io::exr::write_exr(&output, &result.image)?;
     io::png::write_png_preview(&preview, &result.image)?;
+    if let (Some(folder), Some(images)) = (&strategy_folder, estimator.strategy_images()) {
+        io::strategy_images::write(folder, &result.image, &images, true)?;
+        eprintln!(
+            "{}: {} strategies (weighted and unweighted images, pyramids, strategies.csv) -> {}",
+            args.common.estimator,
+            images.len(),
+            folder.display()
+        );
+    }
 
     let stats = &result.stats;
     eprintln!(

@@ -1,17 +1,19 @@
 //! Bidirectional path tracing `bdpt` against closed forms and against `pt` (fixed seeds;
 //! tolerances in standard deviations over independent runs). A wrong multiple-importance
 //! weight shows as bias in every one of these: the weights of the strategies that can make
-//! a path must sum to one for its estimate to be unbiased.
+//! a path must sum to one for its estimate to be unbiased (`bdpt_mis.rs` checks them path
+//! by path, `bdpt_strategies.rs` the strategy images and the efficiency on a caustic).
 //!
 //! * furnace: Le·Σ_{j<d} a^j for each `max_depth` d and Le/(1 − a) unbounded, with the
 //!   balance and the power heuristic; Le·Σ_{1≤j<d} a^j under `hide_emitters`;
 //! * direct illumination of a floor by the Cornell box light (Lambert's formula, also through
 //!   a crop window) and by a point light (the inverse-square law);
-//! * every 4×4 block of the Cornell box with a pinhole, a thin lens, a point light, and a
-//!   mirror and a glass sphere (delta vertices: no strategy may connect there), and of a
-//!   floor with leaning vertex normals, agrees with `pt` (Welch's t over 16 runs, Šidák over
-//!   all blocks and channels at 10⁻³);
-//! * lights at infinity are refused naming the scene; the image does not depend on the
+//! * every 4×4 block of every shipped scene with a pinhole, a thin lens, a point light,
+//!   a mirror and a glass sphere (delta vertices), an environment map seen directly, in a
+//!   mirror and through glass, and a directional light through a window, and of a floor
+//!   with leaning vertex normals, agrees with `pt` (Welch's t over 16 or 32 runs, Šidák over
+//!   all blocks and channels at 10⁻³); the directional light's room also with `lt`;
+//! * bad parameter values are refused naming them; the image does not depend on the
 //!   thread count.
 
 mod render_support;
@@ -119,7 +121,7 @@ fn floor_under_a_point_light_follows_the_inverse_square_law() {
 }
 
 #[test]
-fn agrees_with_pt_block_by_block_on_the_cornell_boxes() {
+fn agrees_with_pt_block_by_block_on_every_shipped_scene() {
     // The point light under the ceiling and the spheres' caustics give both estimators
     // heavy-tailed noise (rare bright samples), for which Welch's t over few runs is too
     // quick to reject: there, a coarser film and more runs, so that each block mean sums
@@ -130,12 +132,29 @@ fn agrees_with_pt_block_by_block_on_the_cornell_boxes() {
         ("cbox-dof.xml", "mis=balance", 32, 16, 2000),
         ("cbox-point.xml", "mis=balance", 16, 32, 3000),
         ("cbox-spheres.xml", "mis=power", 16, 32, 4000),
+        ("cbox-smalllight.xml", "mis=balance", 16, 32, 4500),
+        ("cbox-mm.xml", "mis=balance", 16, 16, 4700),
+        ("envmap-spheres.xml", "mis=balance", 16, 32, 5000),
+        ("envmap-spheres.xml", "mis=power", 16, 32, 5500),
+        ("sun-room.xml", "mis=balance", 16, 32, 6000),
+        ("textures.xml", "mis=balance", 16, 16, 6500),
+        ("textures-plastic.xml", "mis=balance", 16, 16, 6700),
     ] {
         let scene = shipped_scene(file, res);
         let bdpt = runs("bdpt", &scene, &[params], runs_each, 64, seed);
         let pt = runs("pt", &scene, &[], runs_each, 64, seed + 100);
         assert_blocks_agree(&format!("{file} ({params})"), &bdpt, &pt);
     }
+}
+
+#[test]
+fn agrees_with_lt_where_light_tracing_reaches() {
+    // The room lit through its window by a directional light: every path light tracing
+    // can make (no environment, no specular surface between the camera and a vertex).
+    let scene = shipped_scene("sun-room.xml", 16);
+    let bdpt = runs("bdpt", &scene, &[], 32, 64, 7000);
+    let lt = runs("lt", &scene, &[], 32, 64, 7100);
+    assert_blocks_agree("sun-room.xml: bdpt against lt", &bdpt, &lt);
 }
 
 #[test]

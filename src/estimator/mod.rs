@@ -48,8 +48,12 @@ pub trait Estimator: Send {
     /// The current estimate of radiance per pixel.
     fn image(&self) -> Image;
     fn stats(&self) -> Stats;
-    /// One image per bidirectional strategy (s, t), for estimators that keep them
-    /// (`bdpt` with `strategies=true`).
+    /// True when the estimator keeps one image per bidirectional strategy (`bdpt` with
+    /// `strategies=true`).
+    fn keeps_strategy_images(&self) -> bool {
+        false
+    }
+    /// Those images so far.
     fn strategy_images(&self) -> Option<Vec<bdpt::StrategyImage>> {
         None
     }

@@ -7,7 +7,8 @@
 //! * `runner`: one (estimator, run) cell from checkpoint to checkpoint, its files;
 //! * `metrics`, `statistics`: the error measures and the statistics over runs;
 //! * `plot`: convergence and bias plots, the contact sheet;
-//! * `report`: merges whatever cells are present into the summary and the README.
+//! * `report`: merges whatever cells are present into the summary and the README;
+//! * `strategies`: the optional `[strategies]` table, which bdpt strategy carries what.
 
 pub mod metrics;
 pub mod plot;
@@ -16,6 +17,7 @@ pub mod report;
 pub mod runner;
 pub mod spec;
 pub mod statistics;
+pub mod strategies;
 
 use std::path::{Path, PathBuf};
 
@@ -146,6 +148,9 @@ pub fn run(
         }
     }
     let reference = runner::obtain_reference(experiment, &scene, &options.results_root, bar)?;
+    if options.cell.is_none() {
+        strategies::ensure(experiment, &scene, &results, bar)?;
+    }
 
     let todo: Vec<(usize, u32)> = selected
         .into_iter()
@@ -218,5 +223,6 @@ pub fn prepare(experiment: &Experiment, options: &RunOptions, bar: &ProgressBar)
         runner::clear_results(&results)?;
     }
     runner::check_fingerprint(&results, &fingerprint)?;
-    runner::obtain_reference(experiment, &scene, &options.results_root, bar).map(|_| ())
+    runner::obtain_reference(experiment, &scene, &options.results_root, bar)?;
+    strategies::ensure(experiment, &scene, &results, bar)
 }

@@ -20,11 +20,13 @@
 
 mod log_axis;
 mod loglog;
+mod pyramid;
 mod sheet;
 mod text;
 mod viridis;
 
 pub use loglog::{bias_variance_plot, convergence_plot};
+pub use pyramid::{PyramidCell, strategy_pyramid};
 pub use sheet::{check_crops, contact_sheet};
 pub use viridis::viridis;
 

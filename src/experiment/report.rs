@@ -333,7 +333,7 @@ pub fn report(
     write_file_atomically(&dir.join("summary.json"), json.as_bytes())?;
     write_file_atomically(
         &dir.join("README.md"),
-        readme(experiment, &summary, reference).as_bytes(),
+        readme(experiment, results, &summary, reference).as_bytes(),
     )?;
     Ok(summary)
 }
@@ -406,7 +406,12 @@ fn sci(x: f64) -> String {
     format!("{x:.3e}")
 }
 
-fn readme(experiment: &Experiment, s: &Summary, reference: &Reference) -> String {
+fn readme(
+    experiment: &Experiment,
+    results: &ResultsDir,
+    s: &Summary,
+    reference: &Reference,
+) -> String {
     let mut md = String::new();
     let _ = writeln!(md, "# Experiment `{}`\n\n{}\n", s.experiment, s.description);
     let _ = writeln!(
@@ -537,6 +542,9 @@ fn readme(experiment: &Experiment, s: &Summary, reference: &Reference) -> String
     let _ = writeln!(md, "![relMSE against passes](convergence-passes.png)\n");
     let _ = writeln!(md, "![bias² and variance against time](bias.png)\n");
     let _ = writeln!(md, "![final images and relative-error maps](contact.png)\n");
+    if let Some(section) = super::strategies::readme_section(experiment, results) {
+        md.push_str(&section);
+    }
     let _ = writeln!(
         md,
         "Data: `metrics.csv` (every checkpoint of every run), `summary.csv`, `summary.json`."

@@ -25,10 +25,17 @@
 //! width = 32
 //! height = 24
 //!
+//! [strategies]                       # optional: which bdpt strategy carries which light
+//! passes = 256                       # bdpt passes (× [quick] scale), one image per (s, t)
+//! params = { mis = "power" }         # optional bdpt parameters
+//!
 //! [quick]                            # what --quick does (defaults shown)
 //! scale = 0.1                        # budgets (experiment and reference) × scale
 //! runs = 2                           # at most this many runs
 //! ```
+//!
+//! `strategies` and `strategies_max_depth`, `bdpt`'s diagnostic of `render`, are refused
+//! among an estimator's params: the `[strategies]` table measures the same for a report.
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -58,7 +65,16 @@ struct SpecFile {
     estimators: Vec<Spanned<EstimatorFile>>,
     #[serde(default, rename = "region")]
     regions: Vec<Spanned<Region>>,
+    strategies: Option<Spanned<StrategiesFile>>,
     quick: Option<Spanned<QuickFile>>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StrategiesFile {
+    passes: u32,
+    #[serde(default)]
+    params: BTreeMap<String, toml::Value>,
 }
 
 #[derive(Clone, Copy, Debug, Deserialize)]
@@ -144,6 +160,15 @@ pub enum ReferenceSource {
     },
 }
 
+/// The `[strategies]` table: a `bdpt` render with one image per strategy, whose shares of
+/// the image and of each region the report shows.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StrategiesSpec {
+    pub passes: u32,
+    /// `key=value` strings for `bdpt`.
+    pub params: Vec<String>,
+}
+
 /// A validated experiment.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Experiment {
@@ -164,6 +189,7 @@ pub struct Experiment {
     /// The line of each `[[region]]` in the spec, for errors found once the film size is
     /// known (kept apart from `regions`, which the results' fingerprint covers).
     pub region_lines: Vec<u32>,
+    pub strategies: Option<StrategiesSpec>,
 }
 
 /// The most independent runs per estimator (every run is a cell that writes its own
@@ -321,6 +347,21 @@ impl Experiment {
             region_lines.push(line_of(text, spanned.span().start));
         }
 
+        let strategies = match &file.strategies {
+            None => None,
+            Some(spanned) => {
+                let st = spanned.get_ref();
+                let fail = |m: String| fail_at(spanned.span(), "[strategies]", m);
+                if st.passes == 0 {
+                    return Err(fail("[strategies] needs passes >= 1".into()));
+                }
+                Some(StrategiesSpec {
+                    passes: ((st.passes as f64 * scale).ceil() as u32).max(1),
+                    params: params_to_strings(&st.params).map_err(fail)?,
+                })
+            }
+        };
+
         let scene_params = file
             .scene_params
             .iter()
@@ -346,6 +387,7 @@ impl Experiment {
             estimators,
             regions,
             region_lines,
+            strategies,
         })
     }
 
@@ -445,6 +487,15 @@ fn is_safe_label(label: &str) -> bool {
 fn params_to_strings(
     params: &BTreeMap<String, toml::Value>,
 ) -> std::result::Result<Vec<String>, String> {
+    if let Some(key) = ["strategies", "strategies_max_depth"]
+        .into_iter()
+        .find(|k| params.contains_key(*k))
+    {
+        return Err(format!(
+            "parameter \"{key}\" is a diagnostic of `mltbench render` (one image per bdpt \
+             strategy); an experiment measures the strategies with a [strategies] table instead"
+        ));
+    }
     params
         .iter()
         .map(|(k, v)| Ok(format!("{k}={}", value_to_string(k, v)?)))

@@ -4,6 +4,7 @@ pub mod atomic;
 pub mod exr;
 pub mod outputs;
 pub mod png;
+pub mod strategy_images;
 pub mod texture_file;
 pub mod tonemap;
 

@@ -233,4 +233,76 @@ mod tests {
         assert_eq!(balance_heuristic(3e38, 3e38), 0.5);
         assert_eq!(power_heuristic(f32::INFINITY, 1.0), 0.0);
     }
+
+    /// Vertices 0..12 (light to camera) where only strategies s = 1 and s = 11 can connect,
+    /// with `factors[j]` = from_camera / from_light of vertex j.
+    fn path_with_ratios(factors: &[(f32, f32)]) -> Vec<PathDensity> {
+        factors
+            .iter()
+            .enumerate()
+            .map(|(j, &(from_camera, from_light))| PathDensity {
+                from_light,
+                from_camera,
+                connectible: matches!(j, 0 | 1 | 10 | 11),
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_ratio_far_below_f64_on_the_way_does_not_lose_a_strategy_of_equal_density() {
+        // Going from s = 11 down to s = 1 the ratio falls to 10⁻³⁵⁰ (below f64) and climbs
+        // back to 1: both strategies have the same density, weight ½ each.
+        let mut factors = vec![(1.0, 1.0)];
+        factors.extend([(1e35, 1e-35); 5]);
+        factors.extend([(1e-35, 1e35); 5]);
+        factors.push((1.0, 1.0));
+        let path = path_with_ratios(&factors);
+        for heuristic in [Heuristic::Balance, Heuristic::Power] {
+            let rules = StrategyRules {
+                heuristic,
+                hide_emitters: false,
+                light_hittable: false,
+                light_seen_by_camera: true,
+            };
+            for s in [1, 11] {
+                let w = strategy_weight(&path, s, &rules);
+                assert!((w - 0.5).abs() < 1e-6, "{heuristic:?}, s = {s}: {w}");
+            }
+            assert_eq!(strategy_weight(&path, 5, &rules), 0.0, "not connectible");
+        }
+    }
+
+    #[test]
+    fn weights_of_every_strategy_sum_to_one_and_skip_the_ones_that_cannot_make_the_path() {
+        let path: Vec<PathDensity> = [(0.3, 2.0), (4.0, 0.5), (1e-3, 7.0), (2.0, 2.0), (0.0, 1.0)]
+            .iter()
+            .enumerate()
+            .map(|(j, &(from_light, from_camera))| PathDensity {
+                from_light,
+                from_camera,
+                connectible: j != 2,
+            })
+            .collect();
+        let rules = StrategyRules {
+            heuristic: Heuristic::Balance,
+            hide_emitters: false,
+            light_hittable: true,
+            light_seen_by_camera: true,
+        };
+        // Strategies 2 and 3 join at vertex 2, which is not connectible.
+        let w: Vec<f32> = (0..5).map(|s| strategy_weight(&path, s, &rules)).collect();
+        assert_eq!((w[2], w[3]), (0.0, 0.0));
+        assert!((w.iter().sum::<f32>() - 1.0).abs() < 1e-6, "{w:?}");
+        // Balance weights are proportional to the strategies' densities: p_s = Π_{i<s}
+        // from_light · Π_{s≤i<4} from_camera.
+        let p = |s: usize| -> f64 {
+            let l: f64 = path[..s].iter().map(|v| v.from_light as f64).product();
+            let c: f64 = path[s..4].iter().map(|v| v.from_camera as f64).product();
+            l * c
+        };
+        let total = p(0) + p(1) + p(4);
+        for s in [0, 1, 4] {
+            assert!((w[s] as f64 - p(s) / total).abs() < 1e-6, "s = {s}");
+        }
+    }
 }

@@ -402,6 +402,10 @@ impl Estimator for Bdpt {
         self.stats.clone()
     }
 
+    fn keeps_strategy_images(&self) -> bool {
+        self.strategy_images.is_some()
+    }
+
     fn strategy_images(&self) -> Option<Vec<StrategyImage>> {
         Bdpt::strategy_images(self)
     }

@@ -69,14 +69,14 @@ fn check_image(what: &str, image: &Image) -> Result<()> {
 }
 
 /// BT.709 luminance of linear sRGB, as `io::tonemap` measures it (negative counts as 0).
-fn luminance(c: [f32; 3]) -> f64 {
+pub(super) fn luminance(c: [f32; 3]) -> f64 {
     (0.2126 * c[0] as f64 + 0.7152 * c[1] as f64 + 0.0722 * c[2] as f64).max(0.0)
 }
 
 /// Reinhard's operator with the reference's exposure: the scale a/L̄w and L_white are those
 /// the default operator picks for the reference, so that every image on the sheet is mapped
 /// by the same curve and differences in brightness stay visible.
-fn exposure_like(reference: &Image) -> impl Fn(&Image) -> Image {
+pub(super) fn exposure_like(reference: &Image) -> impl Fn(&Image) -> Image {
     let base = Reinhard::default();
     let ref_average = base.log_average_luminance(reference);
     let scale = base.key / ref_average;
@@ -101,7 +101,7 @@ fn exposure_like(reference: &Image) -> impl Fn(&Image) -> Image {
 /// Resamples the region `(x0, y0, w, h)` of a row-major grid of width `stride` to `ow` × `oh`:
 /// each output pixel averages the source pixels it covers when shrinking, and repeats the
 /// nearest one when enlarging. NaN stays NaN.
-fn resample<const N: usize>(
+pub(super) fn resample<const N: usize>(
     src: &[[f32; N]],
     stride: usize,
     (x0, y0, w, h): (usize, usize, usize, usize),
@@ -134,7 +134,7 @@ fn resample<const N: usize>(
 
 /// The size of a `w` × `h` region scaled to fit a `box_w` × `box_h` box: by a whole factor
 /// when enlarging (crisp nearest-neighbour pixels), by the exact ratio when shrinking.
-fn fit(w: u32, h: u32, box_w: u32, box_h: u32) -> (u32, u32) {
+pub(super) fn fit(w: u32, h: u32, box_w: u32, box_h: u32) -> (u32, u32) {
     let s = (box_w as f64 / w as f64).min(box_h as f64 / h as f64);
     let s = if s >= 1.0 { s.floor() } else { s };
     (
@@ -144,13 +144,13 @@ fn fit(w: u32, h: u32, box_w: u32, box_h: u32) -> (u32, u32) {
 }
 
 /// An 8-bit RGB canvas the tiles are copied into before plotters adds text and outlines.
-struct Canvas {
-    width: u32,
-    rgb: Vec<u8>,
+pub(super) struct Canvas {
+    pub(super) width: u32,
+    pub(super) rgb: Vec<u8>,
 }
 
 impl Canvas {
-    fn put(&mut self, x: u32, y: u32, w: u32, pixels: &[[u8; 3]]) {
+    pub(super) fn put(&mut self, x: u32, y: u32, w: u32, pixels: &[[u8; 3]]) {
         for (i, p) in pixels.iter().enumerate() {
             let (px, py) = (x + i as u32 % w, y + i as u32 / w);
             let at = 3 * (py as usize * self.width as usize + px as usize);
