@@ -160,6 +160,7 @@ impl ScaledRatio {
     const LIMIT: f64 = 1.157_920_892_373_162e77;
 
     /// self × num / den.
+    #[inline]
     fn times(self, num: f32, den: f32) -> ScaledRatio {
         if num == 0.0 {
             return ScaledRatio { m: 0.0, e: 0 };

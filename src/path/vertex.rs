@@ -69,6 +69,9 @@ pub struct Vertex<'a> {
     pub pdf_rev: f32,
     /// The BSDF sample that left this vertex was a delta component.
     pub delta: bool,
+    /// A connection can end here: a surface whose BSDF has a non-delta component, any
+    /// light, the camera (`is_connectible`, kept so that weights need not ask the BSDF).
+    connectible: bool,
     /// Unit world direction towards the previous vertex of its subpath (surfaces).
     pub wo: Vec3,
 }
@@ -83,6 +86,7 @@ impl<'a> Vertex<'a> {
             pdf_fwd: 1.0,
             pdf_rev: 0.0,
             delta: false,
+            connectible: true,
             wo: Vec3::ZERO,
         }
     }
@@ -97,6 +101,7 @@ impl<'a> Vertex<'a> {
             pdf_fwd: pdf,
             pdf_rev: 0.0,
             delta: false,
+            connectible: true,
             wo: Vec3::ZERO,
         }
     }
@@ -112,6 +117,7 @@ impl<'a> Vertex<'a> {
             pdf_fwd: 0.0,
             pdf_rev: 0.0,
             delta: false,
+            connectible: true,
             wo: Vec3::ZERO,
         }
     }
@@ -119,6 +125,7 @@ impl<'a> Vertex<'a> {
     /// A surface vertex reached along `wo`'s opposite with throughput `beta`.
     pub fn surface(scene: &'a Scene, si: SurfaceInteraction, wo: Vec3, beta: Rgb) -> Self {
         let bsdf = scene.bsdf_at(&si);
+        let connectible = bsdf.has_non_delta();
         Vertex {
             p: si.p,
             ng: si.ng,
@@ -131,17 +138,16 @@ impl<'a> Vertex<'a> {
             pdf_fwd: 0.0,
             pdf_rev: 0.0,
             delta: false,
+            connectible,
             wo,
         }
     }
 
     /// True when a connection can end here: a surface with a non-delta component, any
     /// light, the camera.
+    #[inline]
     pub fn is_connectible(&self) -> bool {
-        match &self.kind {
-            VertexKind::Surface { bsdf, .. } => bsdf.has_non_delta(),
-            _ => true,
-        }
+        self.connectible
     }
 
     /// A light that no ray can hit: a point, spot or directional light.
