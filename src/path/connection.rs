@@ -64,6 +64,9 @@ pub fn connect<'a>(
         return light_vertex_to_camera(scene, light_path, start, s, hide_emitters, sampler);
     }
     let pt = &camera_path[t - 1];
+    if !pt.is_connectible() {
+        return None;
+    }
     let VertexKind::Surface {
         si: si_pt,
         bsdf: bsdf_pt,
@@ -72,9 +75,6 @@ pub fn connect<'a>(
     else {
         return None;
     };
-    if !bsdf_pt.has_non_delta() {
-        return None;
-    }
     if s == 1 {
         // Next-event estimation from z(t−1).
         let u_light = sampler.next_1d();
@@ -112,6 +112,9 @@ pub fn connect<'a>(
         });
     }
     let qs = &light_path[s - 1];
+    if !qs.is_connectible() {
+        return None;
+    }
     let VertexKind::Surface {
         si: si_qs,
         bsdf: bsdf_qs,
@@ -120,9 +123,6 @@ pub fn connect<'a>(
     else {
         return None;
     };
-    if !bsdf_qs.has_non_delta() {
-        return None;
-    }
     let d = pt.p - qs.p;
     let dist2 = d.length_squared();
     if dist2.is_nan() || dist2 <= 0.0 {

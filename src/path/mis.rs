@@ -79,6 +79,7 @@ pub struct StrategyRules {
 impl StrategyRules {
     /// True when strategy s (s light vertices, t = k + 1 − s camera vertices, t ≥ 1) can
     /// make a path of `path.len()` vertices.
+    #[inline(always)]
     fn can_make(&self, path: &[PathDensity], s: usize) -> bool {
         let n = path.len();
         debug_assert!(s < n, "strategies keep at least one camera vertex");
@@ -107,47 +108,43 @@ pub fn strategy_weight(path: &[PathDensity], s: usize, rules: &StrategyRules) ->
     if s >= n || !rules.can_make(path, s) {
         return 0.0;
     }
-    let h = |r: ScaledRatio| match rules.heuristic {
-        Heuristic::Balance => r.value(),
-        Heuristic::Power => r.squared_value(),
-    };
+    let power = rules.heuristic == Heuristic::Power;
     let mut sum = 1.0f64;
-    // Strategies with fewer light vertices: x(j) moves to the camera side.
+    // Strategies with fewer light vertices: x(j) moves to the camera side. A density of 0
+    // there ends them all (each later one needs it too).
     let mut ratio = ScaledRatio::ONE;
     for j in (0..s).rev() {
-        ratio = ratio.times(path[j].from_camera, path[j].from_light);
-        if ratio.is_infinite() {
-            return 0.0;
-        }
-        if ratio.is_zero() {
+        let v = &path[j];
+        if v.from_camera == 0.0 {
             break;
         }
+        if !ratio.times(v.from_camera, v.from_light) {
+            return 0.0;
+        }
         if rules.can_make(path, j) {
-            sum += h(ratio);
+            sum += ratio.heuristic(power);
         }
     }
     // Strategies with more light vertices: x(j − 1) moves to the light side.
     let mut ratio = ScaledRatio::ONE;
     for j in s + 1..n {
-        ratio = ratio.times(path[j - 1].from_light, path[j - 1].from_camera);
-        if ratio.is_infinite() {
-            return 0.0;
-        }
-        if ratio.is_zero() {
+        let v = &path[j - 1];
+        if v.from_light == 0.0 {
             break;
         }
+        if !ratio.times(v.from_light, v.from_camera) {
+            return 0.0;
+        }
         if rules.can_make(path, j) {
-            sum += h(ratio);
+            sum += ratio.heuristic(power);
         }
     }
     let w = 1.0 / sum;
     if w.is_finite() { w as f32 } else { 0.0 }
 }
 
-/// A non-negative ratio m·2^e with m kept in [2⁻²⁵⁶, 2²⁵⁶]: a product of path densities
-/// that no f64 overflow or underflow cuts short. Infinite once a factor is (a density of 0
-/// in a denominator: the other strategy's density has no finite ratio to ours); zero stays
-/// zero (every later strategy needs the density that was 0).
+/// A positive ratio m·2^e, m kept within [2⁻²⁵⁶, 2²⁵⁶]: a product of path densities that no
+/// f64 overflow or underflow cuts short.
 #[derive(Clone, Copy, Debug)]
 struct ScaledRatio {
     m: f64,
@@ -159,54 +156,51 @@ impl ScaledRatio {
     /// 2²⁵⁶.
     const LIMIT: f64 = 1.157_920_892_373_162e77;
 
-    /// self × num / den.
-    #[inline]
-    fn times(self, num: f32, den: f32) -> ScaledRatio {
-        if num == 0.0 {
-            return ScaledRatio { m: 0.0, e: 0 };
+    /// self × num / den for num > 0; false when the ratio is infinite (den = 0: the other
+    /// strategy's density has no finite ratio to ours, and this one's weight is 0).
+    #[inline(always)]
+    fn times(&mut self, num: f32, den: f32) -> bool {
+        self.m *= num as f64 / den as f64;
+        if self.m > Self::LIMIT || self.m < 1.0 / Self::LIMIT {
+            return self.rescale();
         }
-        let factor = num as f64 / den as f64;
-        if !factor.is_finite() {
-            return ScaledRatio {
-                m: f64::INFINITY,
-                e: self.e,
-            };
+        true
+    }
+
+    /// Moves powers of 2²⁵⁶ from m to e; false for an infinite or NaN m.
+    #[cold]
+    fn rescale(&mut self) -> bool {
+        if !self.m.is_finite() {
+            return false;
         }
-        let (mut m, mut e) = (self.m * factor, self.e);
-        while m > Self::LIMIT {
-            m /= Self::LIMIT;
-            e += 256;
+        while self.m > Self::LIMIT {
+            self.m /= Self::LIMIT;
+            self.e += 256;
         }
-        while m != 0.0 && m < 1.0 / Self::LIMIT {
-            m *= Self::LIMIT;
-            e -= 256;
+        while self.m < 1.0 / Self::LIMIT {
+            self.m *= Self::LIMIT;
+            self.e -= 256;
         }
-        ScaledRatio { m, e }
+        true
     }
 
-    fn is_zero(self) -> bool {
-        self.m == 0.0
+    /// The ratio (balance heuristic) or its square (power heuristic) as an f64, ∞ or 0 only
+    /// where that leaves f64's range.
+    #[inline(always)]
+    fn heuristic(self, power: bool) -> f64 {
+        let (m, e) = if power {
+            (self.m * self.m, 2 * self.e)
+        } else {
+            (self.m, self.e)
+        };
+        if e == 0 {
+            m
+        } else {
+            // In two steps, so that 2^e alone does not overflow where the product would not.
+            let half = e / 2;
+            m * 2f64.powi(half) * 2f64.powi(e - half)
+        }
     }
-
-    fn is_infinite(self) -> bool {
-        self.m.is_infinite()
-    }
-
-    /// The ratio as an f64 (∞ or 0 only where it leaves f64's range).
-    fn value(self) -> f64 {
-        times_power_of_two(self.m, self.e)
-    }
-
-    /// The squared ratio as an f64.
-    fn squared_value(self) -> f64 {
-        times_power_of_two(self.m * self.m, 2 * self.e)
-    }
-}
-
-/// m·2^e in two steps, so that 2^e alone does not overflow where the product would not.
-fn times_power_of_two(m: f64, e: i32) -> f64 {
-    let half = e / 2;
-    m * 2f64.powi(half) * 2f64.powi(e - half)
 }
 
 #[cfg(test)]

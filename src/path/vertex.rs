@@ -176,6 +176,7 @@ impl<'a> Vertex<'a> {
     }
 
     /// The unit direction from this vertex to `next` (either may be at infinity).
+    #[inline]
     pub fn direction_to(&self, next: &Vertex) -> Vec3 {
         if next.is_infinite() {
             next.p
@@ -191,6 +192,7 @@ impl<'a> Vertex<'a> {
     /// where `next` lies on a surface); unchanged when `next` is at infinity (a direction);
     /// from a vertex at infinity, whose rays are parallel, a density per unit area of the
     /// emission disk × |cos θ_next|.
+    #[inline]
     pub fn to_area(&self, pdf: f32, next: &Vertex) -> f32 {
         if next.is_infinite() {
             return pdf;
@@ -217,9 +219,31 @@ impl<'a> Vertex<'a> {
     /// density, a light's emission direction density, the emission disk's for a vertex at
     /// infinity. Connections never end at a delta vertex, so this is only asked of
     /// non-delta sampling.
+    #[inline]
     pub fn pdf(&self, scene: &Scene, prev: Option<&Vertex>, next: &Vertex) -> f32 {
-        let w = self.direction_to(next);
-        let pdf = match &self.kind {
+        if self.is_infinite() || next.is_infinite() {
+            let pdf = self.pdf_solid_angle(scene, prev, self.direction_to(next));
+            return self.to_area(pdf, next);
+        }
+        // `to_area` with the distance computed once.
+        let d = next.p - self.p;
+        let dist2 = d.length_squared();
+        if dist2.is_nan() || dist2 <= 0.0 {
+            return 0.0;
+        }
+        let w = d / dist2.sqrt();
+        let mut pdf = self.pdf_solid_angle(scene, prev, w) / dist2;
+        if next.ng != Vec3::ZERO {
+            pdf *= next.ng.dot(w).abs();
+        }
+        if pdf.is_finite() { pdf } else { 0.0 }
+    }
+
+    /// The density per unit solid angle (per unit area of the emission disk at infinity) of
+    /// this vertex's sampling leaving in unit direction `w`.
+    #[inline]
+    fn pdf_solid_angle(&self, scene: &Scene, prev: Option<&Vertex>, w: Vec3) -> f32 {
+        match &self.kind {
             VertexKind::Surface { bsdf, frame, .. } => {
                 let Some(prev) = prev else { return 0.0 };
                 let wp = self.direction_to(prev);
@@ -230,8 +254,7 @@ impl<'a> Vertex<'a> {
                 scene.lights.get(*light).pdf_le(self.p, self.ng, w).1
             }
             VertexKind::Infinite { .. } => scene.lights.sphere().disk_pdf(),
-        };
-        self.to_area(pdf, next)
+        }
     }
 
     /// For a vertex on an emitter (a light vertex, a camera-subpath surface vertex on an
