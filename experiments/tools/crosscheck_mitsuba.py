@@ -106,7 +106,11 @@ def worker(job_file):
     if declares_spp:
         params["spp"] = str(max(spps))
     t0 = time.perf_counter()
-    scene = mi.load_file(scene_path, **params)
+    # Without merging: Mitsuba 3.9 merges shapes of equal BSDFs into one mesh and leaves its
+    # bounding box out of the scene's bounding sphere, whose radius bounds a directional
+    # light's shadow rays (2R): in a room (experiments/scenes/sun-room.xml) they then stop
+    # short of the walls and light what the walls shadow.
+    scene = mi.load_file(scene_path, optimize=False, **params)
     load_seconds = time.perf_counter() - t0
     dr.set_thread_count(job["threads"])
     film = scene.sensors()[0].film()
