@@ -406,13 +406,22 @@ fn sci(x: f64) -> String {
     format!("{x:.3e}")
 }
 
+/// `mean [lo, hi]`, or `mean [–]` from a single run (which gives no interval).
+pub fn with_interval(i: &Interval, runs: usize) -> String {
+    if runs < 2 {
+        format!("{} [–]", sci(i.mean))
+    } else {
+        format!("{} [{}, {}]", sci(i.mean), sci(i.lo), sci(i.hi))
+    }
+}
+
 fn readme(experiment: &Experiment, s: &Summary, reference: &Reference) -> String {
     let mut md = String::new();
     let _ = writeln!(md, "# Experiment `{}`\n\n{}\n", s.experiment, s.description);
     let _ = writeln!(
         md,
         "Scene `{}`, budget {} per run, {} checkpoints, {} runs per estimator. \
-         Reproduce with `cargo run --release -- run {}`.\n",
+         Reproduce with `cargo run --release -- run {}{}`.\n",
         experiment
             .scene
             .file_name()
@@ -425,7 +434,8 @@ fn readme(experiment: &Experiment, s: &Summary, reference: &Reference) -> String
             .spec_path
             .file_stem()
             .and_then(|f| f.to_str())
-            .unwrap_or("")
+            .unwrap_or(""),
+        if experiment.quick { " --quick" } else { "" }
     );
     let _ = writeln!(
         md,
@@ -466,14 +476,12 @@ fn readme(experiment: &Experiment, s: &Summary, reference: &Reference) -> String
         let bv = e.bias_variance.as_ref();
         let _ = writeln!(
             md,
-            "| {} | {} | {:.2} | {:.0} | {} [{}, {}]{} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {:.2} | {:.0} | {}{} | {} | {} | {} | {} | {} |",
             e.label,
             e.runs,
             e.seconds,
             e.passes,
-            sci(e.relmse.mean),
-            sci(e.relmse.lo),
-            sci(e.relmse.hi),
+            with_interval(&e.relmse, e.runs),
             flag,
             e.slope_seconds
                 .map(|f| format!("{:.2} ± {:.2}", f.slope, f.slope_se))
@@ -510,14 +518,7 @@ fn readme(experiment: &Experiment, s: &Summary, reference: &Reference) -> String
         );
         for e in &s.estimators {
             if let Some((_, i)) = e.regions.iter().find(|(l, _)| *l == region.label) {
-                let _ = writeln!(
-                    md,
-                    "- {}: {} [{}, {}]",
-                    e.label,
-                    sci(i.mean),
-                    sci(i.lo),
-                    sci(i.hi)
-                );
+                let _ = writeln!(md, "- {}: {}", e.label, with_interval(i, e.runs));
             }
         }
     }
