@@ -133,9 +133,12 @@ wait_jobs() {
 job_states() {
     local id line
     for id in "$@"; do
-        line="$(scontrol -o show job "$id" 2>&1 | head -n 1)" || true
-        echo "    $id: $(grep -o 'JobName=[^ ]*\|JobState=[^ ]*\|Reason=[^ ]*\|ExitCode=[^ ]*' <<<"$line" |
-            paste -s -d ' ' || echo "$line")"
+        if line="$(scontrol -o show job "$id" 2>/dev/null | head -n 1)" && [[ -n "$line" ]]; then
+            echo "    $id: $(grep -o 'JobName=[^ ]*\|JobState=[^ ]*\|Reason=[^ ]*\|ExitCode=[^ ]*' <<<"$line" |
+                paste -s -d ' ')"
+        else
+            echo "    $id: no record (an array task cancelled before it started)"
+        fi
     done
 }
 # "submitted: prepare P, N of M cells as array A (...), report R" -> the numbers P, A, R.
