@@ -85,6 +85,12 @@ if [[ -n "${MLTBENCH:-}" ]]; then
 else
     read -r -a levels <<<"${CPU_LEVELS:-x86-64-v2 x86-64-v3 x86-64-v4}"
     ((${#levels[@]})) || die "CPU_LEVELS is empty"
+    for level in "${levels[@]}"; do
+        case "$level" in
+        x86-64 | x86-64-v2 | x86-64-v3 | x86-64-v4) ;;
+        *) die "CPU_LEVELS: $level is not one of x86-64, x86-64-v2, x86-64-v3, x86-64-v4" ;;
+        esac
+    done
     bin="${CARGO_TARGET_DIR:-$repo/target}/slurm"
     for level in "${levels[@]}"; do
         echo "run-array.sh: building mltbench for $level" >&2
