@@ -656,7 +656,10 @@ fn a_slurm_array_runs_the_missing_cells_and_reports() {
 
     for extra in [&[][..], &["--fresh"]] {
         let stdout = run(extra);
-        assert!(stdout.contains("4 of 4 cells as array 102 (0-3)"), "{stdout}");
+        assert!(
+            stdout.contains("4 of 4 cells as array 102 (0-3)"),
+            "{stdout}"
+        );
         assert!(summary().contains("\"missing_cells\": []"), "{extra:?}");
         assert_eq!(files_under(&results.join("tiny/cells")).len(), 4);
         let calls = take_calls(&dir.join(""));
@@ -674,7 +677,10 @@ fn a_slurm_array_runs_the_missing_cells_and_reports() {
         let prepare_args = &prepare[prepare.iter().position(|a| a == "--").unwrap()..];
         assert!(!prepare_args.iter().any(|a| a == "--cell"));
         assert_eq!(prepare_args.iter().filter(|a| *a == "--threads").count(), 1);
-        assert_eq!(prepare_args.contains(&"--fresh".to_string()), extra == ["--fresh"]);
+        assert_eq!(
+            prepare_args.contains(&"--fresh".to_string()),
+            extra == ["--fresh"]
+        );
         let cell_args = &cells[cells.iter().position(|a| a == "--").unwrap()..];
         assert_eq!(cell_args.iter().filter(|a| *a == "--threads").count(), 1);
         assert!(!cell_args.iter().any(|a| a == "--fresh"));
@@ -752,4 +758,54 @@ fn a_failed_slurm_prepare_job_cancels_the_array_and_the_report_says_why() {
             && report.contains("\"light\""),
         "{report}"
     );
+}
+
+#[test]
+fn the_cli_lists_cell_status_and_its_hints_name_quick_and_results() {
+    let dir = temp_dir("cli-quick");
+    let spec = tiny_spec(&dir, "{ passes = 4 }");
+    let mut text = std::fs::read_to_string(&spec).unwrap();
+    text.push_str("\n[quick]\nscale = 1\nruns = 1\n");
+    std::fs::write(&spec, text).unwrap();
+    let stderr = |o: &std::process::Output| String::from_utf8_lossy(&o.stderr).to_string();
+    fn with<'a>(args: &[&'a str]) -> Vec<&'a str> {
+        [args, &["--quick", "--results", "my res"][..]].concat()
+    }
+
+    let cell = mltbench_in(&dir, &with(&["run", "tiny.toml", "--cell", "1"]));
+    assert!(cell.status.success(), "{}", stderr(&cell));
+    let hint = "`mltbench report tiny.toml --quick --results 'my res'` merges the cells";
+    assert!(
+        stderr(&cell).contains(&format!("cell 1 done; {hint}")),
+        "{}",
+        stderr(&cell)
+    );
+    let again = mltbench_in(&dir, &with(&["run", "tiny.toml", "--cell", "1"]));
+    assert!(
+        stderr(&again).contains(&format!(
+            "cell 1 was already complete (kept as it was); {hint}"
+        )),
+        "{}",
+        stderr(&again)
+    );
+    let cells = mltbench_in(&dir, &with(&["run", "tiny.toml", "--cells"]));
+    let listing = String::from_utf8_lossy(&cells.stdout);
+    let rows: Vec<&str> = listing.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(
+        rows,
+        ["0\tpt\t0\ttodo", "1\tpreview (biased)\t0\tcomplete"],
+        "{listing}"
+    );
+
+    // One run per estimator under --quick: the README says how to reproduce it, and the
+    // relMSE has no interval, as the other columns that need two runs.
+    let run = mltbench_in(&dir, &with(&["run", "tiny.toml"]));
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(stderr(&run).contains("relMSE") && stderr(&run).contains(" [–] after"));
+    let readme = std::fs::read_to_string(dir.join("my res/tiny-quick/README.md")).unwrap();
+    assert!(readme.contains("Reproduce with `cargo run --release -- run tiny --quick`"));
+    let row = readme.lines().find(|l| l.starts_with("| pt |")).unwrap();
+    assert!(row.contains(" [–] |") && !row.contains(", "), "{row}");
+    let region = readme.lines().find(|l| l.starts_with("- pt: ")).unwrap();
+    assert!(region.ends_with(" [–]"), "{region}");
 }
