@@ -157,19 +157,16 @@ fn estimator_help() -> String {
 }
 
 fn main() -> ExitCode {
-    #[cfg(target_arch = "x86_64")]
-    {
-        // Before anything else: a build for other CPUs would die of an illegal instruction.
-        let missing = missing_cpu_features();
-        if !missing.is_empty() {
-            eprintln!(
-                "error: this mltbench was built for CPU features that this machine lacks ({}): \
-                 build it here, or for a CPU level every machine has (RUSTFLAGS=\"-C \
-                 target-cpu=x86-64-v2\"; see the README, \"On a cluster\")",
-                missing.join(", ")
-            );
-            return ExitCode::FAILURE;
-        }
+    // Before anything else: a build for other CPUs would die of an illegal instruction.
+    let missing = mltbench::cpu::missing_features();
+    if !missing.is_empty() {
+        eprintln!(
+            "error: this mltbench was built for CPU features that this machine lacks ({}): \
+             build it here, or for a CPU level every machine has (RUSTFLAGS=\"-C \
+             target-cpu=x86-64-v2\"; see the README, \"On a cluster\")",
+            missing.join(", ")
+        );
+        return ExitCode::FAILURE;
     }
     let cli = Cli::parse();
     let outcome = match cli.command {
@@ -193,30 +190,6 @@ fn main() -> ExitCode {
             ExitCode::FAILURE
         }
     }
-}
-
-/// The x86 features this build may use (`-C target-cpu`, `-C target-feature`) that the CPU
-/// it runs on does not have.
-#[cfg(target_arch = "x86_64")]
-fn missing_cpu_features() -> Vec<&'static str> {
-    let mut missing = Vec::new();
-    macro_rules! check {
-        ($($feature:tt),* $(,)?) => {$(
-            if cfg!(target_feature = $feature) && !std::arch::is_x86_feature_detected!($feature) {
-                missing.push($feature);
-            }
-        )*};
-    }
-    #[rustfmt::skip]
-    check!(
-        "sse3", "ssse3", "sse4.1", "sse4.2", "sse4a", "popcnt", "cmpxchg16b", "aes", "pclmulqdq",
-        "sha", "rdrand", "rdseed", "adx", "fxsr", "xsave", "xsaveopt", "xsavec", "xsaves", "avx",
-        "avx2", "fma", "f16c", "bmi1", "bmi2", "lzcnt", "movbe", "gfni", "vaes", "vpclmulqdq",
-        "avxvnni", "avx512f", "avx512cd", "avx512bw", "avx512dq", "avx512vl", "avx512ifma",
-        "avx512vbmi", "avx512vbmi2", "avx512vnni", "avx512bitalg", "avx512vpopcntdq", "avx512bf16",
-        "avx512vp2intersect", "avx512fp16",
-    );
-    missing
 }
 
 /// `render`; Ok(true) when a stop request cut it short (the passes done are written).
