@@ -4,6 +4,7 @@
 //! `image::Image` → files. See DESIGN.md for the map of the crate.
 
 pub mod camera;
+pub mod cpu;
 pub mod error;
 pub mod estimator;
 pub mod experiment;

@@ -160,6 +160,17 @@ fn estimator_help() -> String {
 }
 
 fn main() -> ExitCode {
+    // Before anything else: a build for other CPUs would die of an illegal instruction.
+    let missing = mltbench::cpu::missing_features();
+    if !missing.is_empty() {
+        eprintln!(
+            "error: this mltbench was built for CPU features that this machine lacks ({}): \
+             build it here, or for a CPU level every machine has (RUSTFLAGS=\"-C \
+             target-cpu=x86-64-v2\"; see the README, \"On a cluster\")",
+            missing.join(", ")
+        );
+        return ExitCode::FAILURE;
+    }
     let cli = Cli::parse();
     let outcome = match cli.command {
         Command::Render(args) => match run_render(args) {
@@ -337,16 +348,27 @@ fn run_experiment(args: RunArgs) -> Result<()> {
     }
     let exp = Experiment::load(&path, args.quick)?;
     if args.cells {
+        let complete = experiment::cells_complete(&exp, &args.results)?;
         println!(
-            "# {}: {} cells (cell, estimator label, run)",
+            "# {}: {} cells (cell, estimator label, run, complete or todo in {})",
             exp.name,
-            exp.cells().len()
+            exp.cells().len(),
+            args.results.join(&exp.name).display()
         );
         for (k, (e, r)) in exp.cells().into_iter().enumerate() {
-            println!("{k}\t{}\t{r}", exp.estimators[e].label);
+            let status = if complete[k] { "complete" } else { "todo" };
+            println!("{k}\t{}\t{r}\t{status}", exp.estimators[e].label);
         }
         return Ok(());
     }
+    // Whether the cell asked for is complete already (then `run` keeps it as it is).
+    let already_complete = match args.cell.and_then(|k| exp.cells().get(k).copied()) {
+        Some((e, r)) if !args.fresh => {
+            let results = experiment::runner::ResultsDir::new(&args.results, &exp);
+            experiment::runner::cell_is_complete(&exp, &results, e, r)?
+        }
+        _ => false,
+    };
     let pool = thread_pool(args.threads)?;
     let bar = experiment_bar();
     let options = experiment::RunOptions {
@@ -366,25 +388,47 @@ fn run_experiment(args: RunArgs) -> Result<()> {
     match outcome? {
         Some(summary) => print_summary(&summary, &args.results.join(&exp.name)),
         None if args.prepare => eprintln!("{}: reference ready", exp.name),
-        None => eprintln!(
-            "{}: cell {} done; `mltbench report {}` merges the cells",
-            exp.name,
-            args.cell.unwrap_or(0),
-            args.experiment
-        ),
+        None => {
+            let mut report = format!("mltbench report {}", shell_word(&args.experiment));
+            if args.quick {
+                report.push_str(" --quick");
+            }
+            if args.results != Path::new("results") {
+                report.push_str(" --results ");
+                report.push_str(&shell_word(&args.results.display().to_string()));
+            }
+            eprintln!(
+                "{}: cell {} {}; `{report}` merges the cells",
+                exp.name,
+                args.cell.unwrap_or(0),
+                if already_complete {
+                    "was already complete (kept as it was)"
+                } else {
+                    "done"
+                }
+            )
+        }
     }
     Ok(())
+}
+
+/// `word` as one shell word: as it is when it needs no quoting, else in single quotes.
+fn shell_word(word: &str) -> String {
+    let plain = |c: char| c.is_ascii_alphanumeric() || "_-./=+,:@%".contains(c);
+    if !word.is_empty() && word.chars().all(plain) {
+        word.to_string()
+    } else {
+        format!("'{}'", word.replace('\'', "'\\''"))
+    }
 }
 
 fn print_summary(summary: &experiment::Summary, dir: &Path) {
     eprintln!("{}: results in {}", summary.experiment, dir.display());
     for e in &summary.estimators {
         eprintln!(
-            "  {:<16} relMSE {:.3e} [{:.3e}, {:.3e}] after {:.1} s, slope {}",
+            "  {:<16} relMSE {} after {:.1} s, slope {}",
             e.label,
-            e.relmse.mean,
-            e.relmse.lo,
-            e.relmse.hi,
+            experiment::report::with_interval(&e.relmse, e.runs),
             e.seconds,
             e.slope_seconds
                 .map(|f| format!("{:.2} ± {:.2}", f.slope, f.slope_se))

@@ -534,69 +534,278 @@ fn fresh_with_one_cell_discards_only_that_cells_files() {
     assert_eq!(files_under(&out), before);
 }
 
-/// `experiments/slurm/run-array.sh` with a stand-in `sbatch` that runs each job at once, in
-/// order (array tasks one after another): the Slurm path end to end, without a cluster.
-fn slurm_run(dir: &Path, extra: &[&str]) -> std::process::Output {
-    let fake = dir.join("fake-bin");
-    std::fs::create_dir_all(&fake).unwrap();
-    let sbatch = fake.join("sbatch");
-    std::fs::write(
-        &sbatch,
-        r#"#!/usr/bin/env bash
-# Runs the --wrap command now (once per --array index); prints a job id.
-wrap=""; array=""
+/// A stand-in `sbatch` for `experiments/slurm/run-array.sh`: it refuses what a real one would
+/// refuse or do wrong (an `--output` file whose folder does not exist, a dependency without
+/// `--kill-on-invalid-dep=yes`, an unknown option), records every call's arguments, then
+/// runs the job script at once (each `--array` index in turn) in its `--chdir` with its output
+/// in the `--output` file. A job that depends `afterok` on a failed job is not run, as Slurm
+/// cancels it.
+const FAKE_SBATCH: &str = r#"#!/usr/bin/env bash
+state="$(dirname "$0")"
+id=$(( $(cat "$state/last-id" 2>/dev/null || echo 100) + 1 ))
+echo "$id" >"$state/last-id"
+{ printf '%s\n' "$@"; echo '-- end of call --'; } >>"$state/calls"
+output=""; array=""; dependency=""; kill=""; chdir="$PWD"
 while (($#)); do
     case "$1" in
-        --wrap) wrap="$2"; shift ;;
+        --parsable) ;;
+        --output) output="$2"; shift ;;
         --array) array="$2"; shift ;;
+        --dependency) dependency="$2"; shift ;;
+        --kill-on-invalid-dep=yes) kill=yes ;;
+        --chdir) chdir="$2"; shift ;;
+        --job-name | --cpus-per-task | --time | --partition) shift ;;
+        --account=* | --mem=* | --qos=* | --time=*) ;;
+        -*) echo "sbatch: unrecognized option '$1'" >&2; exit 1 ;;
+        *) break ;;
     esac
     shift
 done
+script="$1"; shift
+if [[ -n "$dependency" && "$kill" != yes ]]; then
+    echo "sbatch: --dependency $dependency without --kill-on-invalid-dep=yes" >&2; exit 1
+fi
+if [[ -z "$output" || ! -d "$(dirname "$output")" ]]; then
+    echo "sbatch: the folder of --output '$output' does not exist" >&2; exit 1
+fi
+echo "$id"
+if [[ "$dependency" == afterok:* ]] && grep -qx "${dependency#afterok:}" "$state/failed" 2>/dev/null; then
+    exit 0
+fi
+cd "$chdir"
+run() { # $1: the array index, or empty
+    local out="${output//%j/$id}"; out="${out//%A/$id}"; out="${out//%a/$1}"; out="${out//%%/%}"
+    SLURM_JOB_ID="$id" SLURM_ARRAY_TASK_ID="$1" bash "$script" "${@:2}" >"$out" 2>&1 ||
+        echo "$id" >>"$state/failed"
+}
 if [[ -n "$array" ]]; then
-    for ((i = ${array%-*}; i <= ${array#*-}; i++)); do
-        SLURM_ARRAY_TASK_ID=$i bash -c "$wrap" >>jobs.log 2>&1 || exit 1
+    IFS=, read -r -a parts <<<"$array"
+    for part in "${parts[@]}"; do
+        for ((i = ${part%-*}; i <= ${part#*-}; i++)); do run "$i" "$@"; done
     done
 else
-    bash -c "$wrap" >>jobs.log 2>&1 || exit 1
+    run "" "$@"
 fi
-echo 1
-"#,
-    )
-    .unwrap();
+"#;
+
+/// Runs `experiments/slurm/run-array.sh SPEC EXTRA...` in `dir` with the stand-in `sbatch`
+/// (state in `dir/fake-bin`) and `MLTBENCH` set to `mltbench`.
+fn slurm_run(dir: &Path, spec: &Path, extra: &[&str], mltbench: &Path) -> std::process::Output {
+    let fake = dir.join("fake-bin");
+    std::fs::create_dir_all(&fake).unwrap();
+    let sbatch = fake.join("sbatch");
+    std::fs::write(&sbatch, FAKE_SBATCH).unwrap();
     use std::os::unix::fs::PermissionsExt;
     std::fs::set_permissions(&sbatch, std::fs::Permissions::from_mode(0o755)).unwrap();
     let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/slurm/run-array.sh");
     let path = format!("{}:{}", fake.display(), std::env::var("PATH").unwrap());
     std::process::Command::new("bash")
         .arg(script)
-        .arg(dir.join("tiny.toml"))
+        .arg(spec)
         .args(extra)
         .env("PATH", path)
-        .env("MLTBENCH", env!("CARGO_BIN_EXE_mltbench"))
+        .env("MLTBENCH", mltbench)
         .env("CPUS_PER_CELL", "1")
+        .env("REPORT_TIME_LIMIT", "00:07:00")
         .current_dir(dir)
         .output()
         .unwrap()
 }
 
+/// The stand-in sbatch's calls since the last `take_calls`, each as its arguments.
+fn take_calls(dir: &Path) -> Vec<Vec<String>> {
+    let file = dir.join("fake-bin/calls");
+    let text = std::fs::read_to_string(&file).unwrap_or_default();
+    let _ = std::fs::remove_file(&file);
+    text.split_terminator("-- end of call --\n")
+        .map(|call| call.lines().map(str::to_string).collect())
+        .collect()
+}
+
+/// The value after `option` in a call.
+fn option<'a>(call: &'a [String], option: &str) -> Option<&'a str> {
+    let i = call.iter().position(|a| a == option)?;
+    call.get(i + 1).map(String::as_str)
+}
+
 #[test]
-fn a_slurm_array_launched_with_fresh_keeps_all_its_cells() {
+fn a_slurm_array_runs_the_missing_cells_and_reports() {
     let dir = temp_dir("slurm");
-    tiny_spec(&dir, "{ passes = 4 }");
-    for extra in [&["--results", "res"][..], &["--fresh", "--results", "res"]] {
-        let out = slurm_run(&dir, extra);
-        let log = std::fs::read_to_string(dir.join("jobs.log")).unwrap_or_default();
+    // NAME as a path and a results folder with a space in it.
+    let spec = dir.join("experiments dir/tiny.toml");
+    std::fs::create_dir_all(spec.parent().unwrap()).unwrap();
+    std::fs::rename(tiny_spec(&dir, "{ passes = 4 }"), &spec).unwrap();
+    let mltbench = Path::new(env!("CARGO_BIN_EXE_mltbench"));
+    let results = dir.join("my res");
+    let logs = results.join("slurm-logs");
+    let site = ["--sbatch-arg=--account=proj42", "--sbatch-arg", "--mem=1G"];
+    let run = |extra: &[&str]| {
+        let mut args = vec!["--results", "my res", "--threads", "1"];
+        args.extend_from_slice(&site);
+        args.extend_from_slice(extra);
+        let out = slurm_run(&dir, &spec, &args, mltbench);
+        let stdout = String::from_utf8_lossy(&out.stdout).to_string();
         assert!(
             out.status.success(),
-            "{extra:?}: {}\n{log}",
+            "{extra:?}: {stdout}\n{}",
             String::from_utf8_lossy(&out.stderr)
         );
-        let summary = std::fs::read_to_string(dir.join("res/tiny/summary.json")).unwrap();
+        stdout
+    };
+    let summary = || std::fs::read_to_string(results.join("tiny/summary.json")).unwrap();
+
+    for extra in [&[][..], &["--fresh"]] {
+        let stdout = run(extra);
         assert!(
-            summary.contains("\"missing_cells\": []"),
-            "{extra:?}: {summary}"
+            stdout.contains("4 of 4 cells as array 102 (0-3)"),
+            "{stdout}"
         );
-        assert_eq!(files_under(&dir.join("res/tiny/cells")).len(), 4);
-        std::fs::remove_file(dir.join("res/tiny/summary.json")).unwrap();
+        assert!(summary().contains("\"missing_cells\": []"), "{extra:?}");
+        assert_eq!(files_under(&results.join("tiny/cells")).len(), 4);
+        let calls = take_calls(&dir.join(""));
+        assert_eq!(calls.len(), 3);
+        let (prepare, cells, report) = (&calls[0], &calls[1], &calls[2]);
+        for call in &calls {
+            // Site options reach every job, after the script's own.
+            let script = call.iter().position(|a| a.ends_with("job.sh")).unwrap();
+            assert!(call[..script].ends_with(&["--account=proj42".into(), "--mem=1G".into()]));
+        }
+        assert_eq!(option(cells, "--dependency"), Some("afterok:101"));
+        assert_eq!(option(report, "--dependency"), Some("afterany:102"));
+        assert_eq!(option(report, "--time"), Some("00:07:00"));
+        // The prepare job gets only what it needs; --threads is given once.
+        let prepare_args = &prepare[prepare.iter().position(|a| a == "--").unwrap()..];
+        assert!(!prepare_args.iter().any(|a| a == "--cell"));
+        assert_eq!(prepare_args.iter().filter(|a| *a == "--threads").count(), 1);
+        assert_eq!(
+            prepare_args.contains(&"--fresh".to_string()),
+            extra == ["--fresh"]
+        );
+        let cell_args = &cells[cells.iter().position(|a| a == "--").unwrap()..];
+        assert_eq!(cell_args.iter().filter(|a| *a == "--threads").count(), 1);
+        assert!(!cell_args.iter().any(|a| a == "--fresh"));
+        // Logs under the results folder, named by job (array: array id and index).
+        for log in [
+            "tiny-prepare-101.out",
+            "tiny-cell-102_0.out",
+            "tiny-cell-102_3.out",
+            "tiny-report-103.out",
+        ] {
+            assert!(logs.join(log).is_file(), "{log} missing");
+        }
+        let cell_log = std::fs::read_to_string(logs.join("tiny-cell-102_2.out")).unwrap();
+        assert!(
+            cell_log.contains("cell 2 done") && cell_log.contains("--results 'my res'"),
+            "{cell_log}"
+        );
+        std::fs::remove_dir_all(&logs).unwrap();
+        std::fs::remove_file(dir.join("fake-bin/last-id")).unwrap();
+        std::fs::remove_file(results.join("tiny/summary.json")).unwrap();
     }
+
+    // A resubmission queues only the cells not complete: none, then one that was cut short.
+    let stdout = run(&[]);
+    assert!(stdout.contains("all 4 cells are complete"), "{stdout}");
+    assert_eq!(take_calls(&dir).len(), 1);
+    assert!(summary().contains("\"missing_cells\": []"));
+    std::fs::remove_file(results.join("tiny/images/pt-run1.exr")).unwrap();
+    let stdout = run(&[]);
+    assert!(stdout.contains("1 of 4 cells as array"), "{stdout}");
+    let calls = take_calls(&dir);
+    assert_eq!(option(&calls[1], "--array"), Some("1"));
+    assert!(summary().contains("\"missing_cells\": []"));
+
+    // Cells 0 and 3 missing, and a folder of builds for MLTBENCH: a list of indices, and each
+    // job runs the build its CPU supports (every x86-64 CPU has level v2).
+    for cell in ["pt-run0", "preview__biased_-run1"] {
+        std::fs::remove_file(results.join(format!("tiny/cells/{cell}.csv"))).unwrap();
+    }
+    let builds = dir.join("builds");
+    std::fs::create_dir_all(builds.join("x86-64-v2/release")).unwrap();
+    std::os::unix::fs::symlink(mltbench, builds.join("x86-64-v2/release/mltbench")).unwrap();
+    let out = slurm_run(&dir, &spec, &["--results", "my res"], &builds);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    assert!(stdout.contains("2 of 4 cells as array"), "{stdout}");
+    assert_eq!(option(&take_calls(&dir)[1], "--array"), Some("0,3"));
+    assert!(summary().contains("\"missing_cells\": []"));
+}
+
+#[test]
+fn a_failed_slurm_prepare_job_cancels_the_array_and_the_report_says_why() {
+    let dir = temp_dir("slurm-fail");
+    // A region off the film: the cells list, but `--prepare` fails before rendering.
+    let spec = tiny_spec(&dir, "{ passes = 4 }");
+    let text = std::fs::read_to_string(&spec).unwrap();
+    std::fs::write(&spec, text.replace("x = 12", "x = 100")).unwrap();
+    let out = slurm_run(
+        &dir,
+        &spec,
+        &["--results", "res"],
+        Path::new(env!("CARGO_BIN_EXE_mltbench")),
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}");
+    assert!(stdout.contains("the report job's log says why"), "{stdout}");
+    let logs = dir.join("res/slurm-logs");
+    assert!(!logs.join("tiny-cell-102_0.out").exists(), "the array ran");
+    let report = std::fs::read_to_string(logs.join("tiny-report-103.out")).unwrap();
+    let prepare_log = logs.join("tiny-prepare-101.out");
+    assert!(
+        report.contains("the prepare job 101 did not succeed")
+            && report.contains(&prepare_log.display().to_string())
+            && report.contains("tiny.toml")
+            && report.contains("\"light\""),
+        "{report}"
+    );
+}
+
+#[test]
+fn the_cli_lists_cell_status_and_its_hints_name_quick_and_results() {
+    let dir = temp_dir("cli-quick");
+    let spec = tiny_spec(&dir, "{ passes = 4 }");
+    let mut text = std::fs::read_to_string(&spec).unwrap();
+    text.push_str("\n[quick]\nscale = 1\nruns = 1\n");
+    std::fs::write(&spec, text).unwrap();
+    let stderr = |o: &std::process::Output| String::from_utf8_lossy(&o.stderr).to_string();
+    fn with<'a>(args: &[&'a str]) -> Vec<&'a str> {
+        [args, &["--quick", "--results", "my res"][..]].concat()
+    }
+
+    let cell = mltbench_in(&dir, &with(&["run", "tiny.toml", "--cell", "1"]));
+    assert!(cell.status.success(), "{}", stderr(&cell));
+    let hint = "`mltbench report tiny.toml --quick --results 'my res'` merges the cells";
+    assert!(
+        stderr(&cell).contains(&format!("cell 1 done; {hint}")),
+        "{}",
+        stderr(&cell)
+    );
+    let again = mltbench_in(&dir, &with(&["run", "tiny.toml", "--cell", "1"]));
+    assert!(
+        stderr(&again).contains(&format!(
+            "cell 1 was already complete (kept as it was); {hint}"
+        )),
+        "{}",
+        stderr(&again)
+    );
+    let cells = mltbench_in(&dir, &with(&["run", "tiny.toml", "--cells"]));
+    let listing = String::from_utf8_lossy(&cells.stdout);
+    let rows: Vec<&str> = listing.lines().filter(|l| !l.starts_with('#')).collect();
+    assert_eq!(
+        rows,
+        ["0\tpt\t0\ttodo", "1\tpreview (biased)\t0\tcomplete"],
+        "{listing}"
+    );
+
+    // One run per estimator under --quick: the README says how to reproduce it, and the
+    // relMSE has no interval, as the other columns that need two runs.
+    let run = mltbench_in(&dir, &with(&["run", "tiny.toml"]));
+    assert!(run.status.success(), "{}", stderr(&run));
+    assert!(stderr(&run).contains("relMSE") && stderr(&run).contains(" [–] after"));
+    let readme = std::fs::read_to_string(dir.join("my res/tiny-quick/README.md")).unwrap();
+    assert!(readme.contains("Reproduce with `cargo run --release -- run tiny --quick`"));
+    let row = readme.lines().find(|l| l.starts_with("| pt |")).unwrap();
+    assert!(row.contains(" [–] |") && !row.contains(", "), "{row}");
+    let region = readme.lines().find(|l| l.starts_with("- pt: ")).unwrap();
+    assert!(region.ends_with(" [–]"), "{region}");
 }

@@ -200,6 +200,17 @@ pub fn run(
     report::report(experiment, &results, &reference).map(Some)
 }
 
+/// For each of the experiment's cells (`Experiment::cells` order), whether its rows and final
+/// image under `results_root` are complete, so that a scheduler queues only the others.
+pub fn cells_complete(experiment: &Experiment, results_root: &Path) -> Result<Vec<bool>> {
+    let results = ResultsDir::new(results_root, experiment);
+    experiment
+        .cells()
+        .into_iter()
+        .map(|(e, r)| runner::cell_is_complete(experiment, &results, e, r))
+        .collect()
+}
+
 /// Merges the cells present under `results/NAME/` into the summary, plots and README.
 pub fn report_only(
     experiment: &Experiment,

@@ -406,6 +406,15 @@ fn sci(x: f64) -> String {
     format!("{x:.3e}")
 }
 
+/// `mean [lo, hi]`, or `mean [–]` from a single run (which gives no interval).
+pub fn with_interval(i: &Interval, runs: usize) -> String {
+    if runs < 2 {
+        format!("{} [–]", sci(i.mean))
+    } else {
+        format!("{} [{}, {}]", sci(i.mean), sci(i.lo), sci(i.hi))
+    }
+}
+
 fn readme(
     experiment: &Experiment,
     results: &ResultsDir,
@@ -417,7 +426,7 @@ fn readme(
     let _ = writeln!(
         md,
         "Scene `{}`, budget {} per run, {} checkpoints, {} runs per estimator. \
-         Reproduce with `cargo run --release -- run {}`.\n",
+         Reproduce with `cargo run --release -- run {}{}`.\n",
         experiment
             .scene
             .file_name()
@@ -430,7 +439,8 @@ fn readme(
             .spec_path
             .file_stem()
             .and_then(|f| f.to_str())
-            .unwrap_or("")
+            .unwrap_or(""),
+        if experiment.quick { " --quick" } else { "" }
     );
     let _ = writeln!(
         md,
@@ -471,14 +481,12 @@ fn readme(
         let bv = e.bias_variance.as_ref();
         let _ = writeln!(
             md,
-            "| {} | {} | {:.2} | {:.0} | {} [{}, {}]{} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {:.2} | {:.0} | {}{} | {} | {} | {} | {} | {} |",
             e.label,
             e.runs,
             e.seconds,
             e.passes,
-            sci(e.relmse.mean),
-            sci(e.relmse.lo),
-            sci(e.relmse.hi),
+            with_interval(&e.relmse, e.runs),
             flag,
             e.slope_seconds
                 .map(|f| format!("{:.2} ± {:.2}", f.slope, f.slope_se))
@@ -515,14 +523,7 @@ fn readme(
         );
         for e in &s.estimators {
             if let Some((_, i)) = e.regions.iter().find(|(l, _)| *l == region.label) {
-                let _ = writeln!(
-                    md,
-                    "- {}: {} [{}, {}]",
-                    e.label,
-                    sci(i.mean),
-                    sci(i.lo),
-                    sci(i.hi)
-                );
+                let _ = writeln!(md, "- {}: {}", e.label, with_interval(i, e.runs));
             }
         }
     }

@@ -174,6 +174,8 @@ pub struct StrategiesSpec {
 pub struct Experiment {
     /// The file stem (`cbox` for `experiments/cbox.toml`), or with `-quick` under --quick.
     pub name: String,
+    /// Loaded with --quick (scaled budgets, capped runs).
+    pub quick: bool,
     pub spec_path: PathBuf,
     pub description: String,
     pub scene: PathBuf,
@@ -375,6 +377,7 @@ impl Experiment {
             } else {
                 stem.to_string()
             },
+            quick,
             spec_path: path.to_path_buf(),
             description: file.description.trim().to_string(),
             scene: dir.join(&file.scene),
