@@ -64,8 +64,9 @@ struct RunArgs {
     /// Run only cell K (see --cells) and write only its files; `report` merges them.
     #[arg(long, value_name = "K")]
     cell: Option<usize>,
-    /// Only make sure the reference exists (renders it if needed) and exit: run this once
-    /// before spreading cells over a cluster.
+    /// Only make sure the reference (and the [strategies] images, if the spec asks for
+    /// them) exist, rendering them if needed, and exit: run this once before spreading
+    /// cells over a cluster.
     #[arg(long, conflicts_with_all = ["cell", "cells"])]
     prepare: bool,
     /// Folder of results (default: results).
