@@ -1,7 +1,7 @@
 //! mltbench: a research bench for light-transport estimators.
 //!
 //! Data flows one way: scene file → `scene::Scene` → estimator passes → `film::Film` →
-//! `image::Image` → files. See DESIGN.md for the map of the crate.
+//! `image::Image` → files. See docs/DESIGN.md for the map of the crate.
 
 pub mod camera;
 pub mod cpu;

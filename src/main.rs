@@ -42,7 +42,7 @@ enum Command {
     /// Render a reference: two independent halves averaged, with the noise estimate from
     /// their difference written to OUT.json beside OUT.exr.
     Reference(ReferenceArgs),
-    /// Print relMSE, RMSE and MAPE (DESIGN.md §5) of an image against a reference.
+    /// Print relMSE, RMSE and MAPE (docs/DESIGN.md §5) of an image against a reference.
     Compare(CompareArgs),
 }
 

@@ -44,6 +44,70 @@ const CHUNK_SECONDS: f64 = 0.05;
 /// The most passes in one chunk.
 const MAX_CHUNK: u32 = 64;
 
+/// How far a run of passes has come: passes done and the seconds they took. `render`,
+/// `reference` and the experiment runner all move it on through `advance`.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Progress {
+    pub passes: u32,
+    /// Time spent in passes (not in what the caller does between calls).
+    pub seconds: f64,
+    /// Passes to take in the next chunk (learned from the time the last chunk took).
+    chunk: u32,
+}
+
+impl Progress {
+    /// True once the budget is spent (a time budget always allows the first pass).
+    pub fn is_spent(&self, budget: Budget) -> bool {
+        match budget {
+            Budget::Passes(n) => self.passes >= n,
+            Budget::Seconds(s) => self.passes > 0 && self.seconds >= s,
+        }
+    }
+}
+
+/// Runs passes through `run_passes(first, count)` (an estimator's `run_passes`, or both
+/// halves' of a reference in turn) until `budget` (passes, or seconds of passes, counted
+/// from the start of `progress`) is spent, or, with `stoppable`, after at least one pass,
+/// until a stop is requested (`interrupt`). Passes go in chunks of about `CHUNK_SECONDS`:
+/// `Estimator::run_passes` gives the bits of one pass at a time. `on_chunk(progress)` is
+/// called after every chunk. Returns true when a stop request cut the budget short.
+pub fn advance(
+    mut run_passes: impl FnMut(u32, u32),
+    budget: Budget,
+    progress: &mut Progress,
+    stoppable: bool,
+    mut on_chunk: impl FnMut(&Progress),
+) -> bool {
+    loop {
+        if progress.is_spent(budget) {
+            return false;
+        }
+        if stoppable && progress.passes > 0 && crate::interrupt::requested() {
+            return true;
+        }
+        let chunk = progress.chunk.max(1);
+        let count = match budget {
+            Budget::Passes(n) => chunk.min(n - progress.passes),
+            Budget::Seconds(_) => chunk,
+        };
+        let start = Instant::now();
+        run_passes(progress.passes, count);
+        let dt = start.elapsed().as_secs_f64();
+        progress.passes += count;
+        progress.seconds += dt;
+        on_chunk(progress);
+        let per_pass = dt / count as f64;
+        let mut next = (CHUNK_SECONDS / per_pass.max(1e-9)).clamp(1.0, MAX_CHUNK as f64) as u32;
+        if let Budget::Seconds(s) = budget {
+            // No more passes than the time left holds (rounded up, as one pass at a time
+            // would start its last pass before the time is up).
+            let left = (s - progress.seconds).max(0.0);
+            next = next.min((left / per_pass.max(1e-9)).ceil().max(1.0) as u32);
+        }
+        progress.chunk = next;
+    }
+}
+
 /// Runs `estimator` on `scene` until `budget` is spent, or, after at least one pass, until a
 /// stop is requested (`interrupt`). `on_pass(done, elapsed)` is called after every chunk of
 /// passes (for progress bars). The image is the same bits as one pass at a time.
@@ -54,35 +118,14 @@ pub fn render(
     mut on_pass: impl FnMut(u32, Duration),
 ) -> RenderOutput {
     let start = Instant::now();
-    let mut pass = 0u32;
-    let mut interrupted = false;
-    // Start with one pass to time it, then chunks of about CHUNK_SECONDS.
-    let mut chunk = 1u32;
-    loop {
-        if budget.is_spent(pass, start) {
-            break;
-        }
-        if pass > 0 && crate::interrupt::requested() {
-            interrupted = true;
-            break;
-        }
-        let count = match budget {
-            Budget::Passes(n) => chunk.min(n - pass),
-            Budget::Seconds(_) => chunk,
-        };
-        let chunk_start = Instant::now();
-        estimator.run_passes(scene, pass, count);
-        pass += count;
-        on_pass(pass, start.elapsed());
-        let seconds_per_pass = chunk_start.elapsed().as_secs_f64() / count as f64;
-        chunk = (CHUNK_SECONDS / seconds_per_pass.max(1e-9)).clamp(1.0, MAX_CHUNK as f64) as u32;
-        if let Budget::Seconds(s) = budget {
-            // No more passes than the time left holds (rounded up, as one pass at a time
-            // would start its last pass before the time is up).
-            let left = (s - start.elapsed().as_secs_f64()).max(0.0);
-            chunk = chunk.min((left / seconds_per_pass.max(1e-9)).ceil().max(1.0) as u32);
-        }
-    }
+    let mut progress = Progress::default();
+    let interrupted = advance(
+        |first, count| estimator.run_passes(scene, first, count),
+        budget,
+        &mut progress,
+        true,
+        |p| on_pass(p.passes, start.elapsed()),
+    );
     RenderOutput {
         image: estimator.image(),
         stats: estimator.stats(),

@@ -491,6 +491,11 @@ fn hand_weights(
     let p_cam = scene.camera.pdf_direction(to_diffuse.as_vec3()) as f64 * nd.dot(to_diffuse).abs()
         / (xd - cam).length_squared();
     let p_pt = p_cam * nd.dot(wd).abs() / std::f64::consts::PI * transmittance / j_camera;
+    // A retraced path that leaves the image (a sample at its very edge) has no camera
+    // strategy to compare with.
+    if !(p_lt > 0.0 && p_lt.is_finite() && p_pt > 0.0 && p_pt.is_finite()) {
+        return None;
+    }
     Some((
         p_lt / (p_lt + p_pt),
         p_lt * p_lt / (p_lt * p_lt + p_pt * p_pt),

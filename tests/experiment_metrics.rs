@@ -1,4 +1,4 @@
-//! The experiment harness's pure computation: DESIGN.md §5 metrics against values worked out
+//! The experiment harness's pure computation: docs/DESIGN.md §5 metrics against values worked out
 //! by hand, the bias/variance decomposition and its t-test on synthetic ensembles with known
 //! bias and noise, the convergence-slope fit on synthetic power laws, and the reference noise
 //! estimate from two independent halves.

@@ -340,11 +340,17 @@ fn millimetre_and_unit_cornell_boxes_render_alike() {
 struct Poisoned;
 
 impl mltbench::estimator::camera_pass::CameraSampleFn for Poisoned {
+    type Scratch<'a> = ();
+    type Extra = ();
+
     fn radiance(
         &self,
         _: &Scene,
         ray: &mltbench::geometry::Ray,
+        _: glam::Vec2,
         _: &mut mltbench::sampler::pixel_samples::CameraSampler,
+        _: &mut (),
+        _: &mut (),
     ) -> (mltbench::math::Rgb, u64) {
         use mltbench::math::Rgb;
         // The camera sits on the z axis: the sign pattern of the direction picks a case.

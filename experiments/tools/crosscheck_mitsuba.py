@@ -2,7 +2,7 @@
 
 Renders SCENE.xml with Mitsuba 3 (pip package `mitsuba`) and with `mltbench render`, at the
 same samples per pixel, then prints per-channel means and their ratio (with a standard error),
-the relMSE between the two images (DESIGN.md §5) and both throughputs in camera paths per
+the relMSE between the two images (docs/DESIGN.md §5) and both throughputs in camera paths per
 second. See CROSSCHECK.md beside this file for installing Mitsuba and reading the output.
 
     /work/venv-mitsuba/bin/python experiments/tools/crosscheck_mitsuba.py \\
@@ -311,7 +311,7 @@ def compare(x, y):
         # Paired: the per-pixel difference has zero mean if both images have the same
         # expectation, and its spread is only the two renders' noise (no image structure).
         sigma_paired = (xs - ys).std(axis=0, ddof=1) / math.sqrt(npix) / np.abs(my)
-    # DESIGN.md §5: relMSE = mean((x - y)^2 / (y^2 + 0.01)) over pixels and channels.
+    # docs/DESIGN.md §5: relMSE = mean((x - y)^2 / (y^2 + 0.01)) over pixels and channels.
     relmse = float(np.mean((x - y) ** 2 / (y * y + 0.01)))
     nonfinite = int(np.count_nonzero(~np.isfinite(x))), int(np.count_nonzero(~np.isfinite(y)))
     return {

@@ -3,10 +3,11 @@
 //! Tiles have a fixed size (not tied to the thread count), each pixel sample seeds its own
 //! random stream from (seed, pixel, sample index), and finished tiles merge into the film
 //! pass by pass, in tile order: the image is bit-identical for any number of threads
-//! (DESIGN.md §3), and for passes run one by one or several at once (`camera_passes`).
+//! (docs/DESIGN.md §3), and for passes run one by one or several at once (`camera_passes`).
 
 use rayon::prelude::*;
 
+use super::bdpt::StrategyImage;
 use super::{Estimator, Stats};
 use crate::camera::{Camera, raster_in_pixel};
 use crate::error::Result;
@@ -18,8 +19,8 @@ use glam::Vec2;
 use std::ops::Range;
 use std::sync::Arc;
 
-use crate::sampler::Sampler;
 use crate::sampler::pixel_samples::{CameraSampler, PixelSamples};
+use crate::sampler::{Sampler, Stream};
 use crate::scene::Scene;
 
 /// Edge length of a tile in pixels.
@@ -33,10 +34,56 @@ pub struct PassCounts {
     pub invalid: u64,
 }
 
-/// What an estimator computes for one camera sample: the radiance along `ray`,
-/// and the number of rays it cast.
+/// A tile of one pass, finished: its pixel sums, its counts, and what its samples added
+/// elsewhere (`CameraSampleFn::Extra`).
+pub struct FinishedTile<E> {
+    pub tile: FilmTile,
+    pub counts: PassCounts,
+    pub extra: E,
+}
+
+/// What an estimator computes for one camera sample: the radiance along `ray` for the
+/// sample's pixel, the rays it cast, and what it adds elsewhere (to `extra`: splats, the
+/// strategy images' records). The driver (`camera_passes`) owns tiles, passes and threads;
+/// the sample function knows nothing of them.
 pub trait CameraSampleFn: Sync {
-    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut CameraSampler) -> (Rgb, u64);
+    /// Buffers reused by every sample of a tile (no allocation per sample).
+    type Scratch<'a>: Default;
+    /// What a tile's samples add beyond their pixels; merged in tile order (`merge_extra`).
+    type Extra: Default + Send + Sync;
+
+    /// The camera sample along `ray`, which leaves the camera at film position `raster`.
+    fn radiance<'a>(
+        &self,
+        scene: &'a Scene,
+        ray: &Ray,
+        raster: Vec2,
+        sampler: &mut CameraSampler,
+        scratch: &mut Self::Scratch<'a>,
+        extra: &mut Self::Extra,
+    ) -> (Rgb, u64);
+
+    /// Adds a finished tile's `extra` to `film` (and to whatever else the estimator keeps),
+    /// tiles in a fixed order; returns the samples it dropped as not finite.
+    fn merge_extra(&mut self, _film: &mut Film, _extra: &mut Self::Extra) -> u64 {
+        0
+    }
+
+    /// True when samples splat light-path contributions (one light path per camera sample):
+    /// the image is then `Film::image_with_light_paths` of the samples taken.
+    fn splats(&self) -> bool {
+        false
+    }
+
+    /// True for an estimator that keeps strategy images (`bdpt` with `strategies=true`).
+    fn keeps_strategy_images(&self) -> bool {
+        false
+    }
+
+    /// The strategy images, for an estimator that keeps them.
+    fn strategy_images(&self, _film: &Film, _samples: u64) -> Option<Vec<StrategyImage>> {
+        None
+    }
 
     /// Tiles that one task renders together (`render_tiles`); 1 unless the estimator keeps
     /// several paths in flight and wants a longer queue of samples to draw them from.
@@ -45,29 +92,34 @@ pub trait CameraSampleFn: Sync {
     }
 
     /// Takes each pass's sample of every pixel of `rects` (consecutive tiles, in order) and
-    /// returns one finished tile with its counts per pass and rect, pass by pass (for each
-    /// pass of `ctx.passes`, the rects in order). By default one sample after the other
+    /// returns one finished tile per pass and rect, pass by pass (for each pass of
+    /// `ctx.passes`, the rects in order). By default one sample after the other
     /// (`render_tile`); an estimator may trace them otherwise, but must return the tiles
     /// `render_tile` would (the same samples added in the same order).
-    fn render_tiles(&self, ctx: &PassContext, rects: &[PixelRect]) -> Vec<(FilmTile, PassCounts)> {
+    fn render_tiles(
+        &self,
+        ctx: &PassContext,
+        rects: &[PixelRect],
+    ) -> Vec<FinishedTile<Self::Extra>> {
         render_tiles_one_by_one(ctx, rects, self)
     }
 }
 
-/// `CameraSampleFn::render_tiles` by default: `render_tile` for each pass and rect.
-pub fn render_tiles_one_by_one(
+/// `CameraSampleFn::render_tiles` by default: `render_tile` for each pass and rect, with
+/// one scratch for them all.
+pub fn render_tiles_one_by_one<S: CameraSampleFn + ?Sized>(
     ctx: &PassContext,
     rects: &[PixelRect],
-    estimate: &(impl CameraSampleFn + ?Sized),
-) -> Vec<(FilmTile, PassCounts)> {
-    ctx.passes
-        .clone()
-        .flat_map(|pass| {
-            rects
-                .iter()
-                .map(move |&rect| render_tile(ctx, rect, pass, estimate))
-        })
-        .collect()
+    estimate: &S,
+) -> Vec<FinishedTile<S::Extra>> {
+    let mut scratch = S::Scratch::default();
+    let mut out = Vec::with_capacity(ctx.passes.len() * rects.len());
+    for pass in ctx.passes.clone() {
+        for &rect in rects {
+            out.push(render_tile(ctx, rect, pass, estimate, &mut scratch));
+        }
+    }
+    out
 }
 
 /// What every task of a run of passes shares.
@@ -89,23 +141,30 @@ impl PassContext<'_> {
 }
 
 /// Takes sample `pass` of every pixel of `rect`, row by row, one after the other.
-pub fn render_tile(
-    ctx: &PassContext,
+pub fn render_tile<'a, S: CameraSampleFn + ?Sized>(
+    ctx: &PassContext<'a>,
     rect: PixelRect,
     pass: u32,
-    estimate: &(impl CameraSampleFn + ?Sized),
-) -> (FilmTile, PassCounts) {
+    estimate: &S,
+    scratch: &mut S::Scratch<'a>,
+) -> FinishedTile<S::Extra> {
     let mut tile = ctx.film.tile(rect);
     let mut counts = PassCounts::default();
+    let mut extra = S::Extra::default();
     let mut sampler = ctx.camera_sampler();
     for y in rect.y0..rect.y1 {
         for x in rect.x0..rect.x1 {
             let (raster, ray) = start_camera_sample(&ctx.scene.camera, &mut sampler, x, y, pass);
-            let (value, rays) = estimate.radiance(ctx.scene, &ray, &mut sampler);
+            let (value, rays) =
+                estimate.radiance(ctx.scene, &ray, raster, &mut sampler, scratch, &mut extra);
             counts.add_sample(&mut tile, raster, value, rays);
         }
     }
-    (tile, counts)
+    FinishedTile {
+        tile,
+        counts,
+        extra,
+    }
 }
 
 impl PassCounts {
@@ -123,15 +182,15 @@ impl PassCounts {
 }
 
 /// Takes samples `passes` of every pixel and adds them to `film`, pass by pass in tile
-/// order (the same bits as one call per pass). Samples that are NaN, infinite or negative
-/// are dropped and counted.
-pub fn camera_passes(
+/// order (the same bits as one call per pass), each tile's extra after its pass's pixels.
+/// Samples that are NaN, infinite or negative are dropped and counted.
+pub fn camera_passes<S: CameraSampleFn>(
     scene: &Scene,
     film: &mut Film,
     seed: u64,
     passes: Range<u32>,
     pixel_samples: &Arc<PixelSamples>,
-    estimate: &impl CameraSampleFn,
+    estimate: &mut S,
 ) -> PassCounts {
     let rects = film.tiles(TILE_SIZE);
     let count = passes.len();
@@ -142,23 +201,30 @@ pub fn camera_passes(
         passes,
         pixel_samples,
     };
-    let finished: Vec<Vec<(FilmTile, PassCounts)>> = rects
-        .par_chunks(estimate.tiles_per_task().max(1))
-        .map(|batch| estimate.render_tiles(&ctx, batch))
+    let shared: &S = estimate;
+    let mut finished: Vec<Vec<FinishedTile<S::Extra>>> = rects
+        .par_chunks(shared.tiles_per_task().max(1))
+        .map(|batch| shared.render_tiles(&ctx, batch))
         .collect();
+    let mut total = PassCounts::default();
     // Each batch's tiles are pass by pass: pass k's are its k-th run of equal length.
     for k in 0..count {
         film.merge_tiles(finished.iter().flat_map(move |batch| {
             let n = batch.len() / count;
-            batch[k * n..(k + 1) * n].iter().map(|(tile, _)| tile)
+            batch[k * n..(k + 1) * n].iter().map(|t| &t.tile)
         }));
+        for batch in finished.iter_mut() {
+            let n = batch.len() / count;
+            for t in &mut batch[k * n..(k + 1) * n] {
+                total.invalid += estimate.merge_extra(film, &mut t.extra);
+            }
+        }
     }
-    let mut total = PassCounts::default();
-    for (tile, counts) in finished.into_iter().flatten() {
-        film.recycle(tile);
-        total.samples += counts.samples;
-        total.rays += counts.rays;
-        total.invalid += counts.invalid;
+    for t in finished.into_iter().flatten() {
+        film.recycle(t.tile);
+        total.samples += t.counts.samples;
+        total.rays += t.counts.rays;
+        total.invalid += t.counts.invalid;
     }
     total
 }
@@ -174,6 +240,7 @@ pub fn start_camera_sample(
     pass_index: u32,
 ) -> (Vec2, Ray) {
     sampler.start_pixel_sample((x, y), pass_index as u64);
+    sampler.start_stream(Stream::Camera);
     let raster = raster_in_pixel(x, y, sampler.next_2d());
     let ray = if camera.has_lens() {
         camera.sample_ray(raster, sampler.next_2d())
@@ -184,7 +251,7 @@ pub fn start_camera_sample(
 }
 
 /// An estimator that takes one camera sample per pixel and pass, computed by `S`
-/// (`eyelight`, `pt`): the film, the seed and the counters they all keep.
+/// (`eyelight`, `pt`, `bdpt`): the film, the seed and the counters they all keep.
 pub struct CameraEstimator<S> {
     name: &'static str,
     film: Film,
@@ -219,6 +286,12 @@ impl<S: CameraSampleFn + Send> CameraEstimator<S> {
         &self.sample
     }
 
+    /// A sampler for this estimator's camera samples of `scene`, as its passes use.
+    pub fn camera_sampler(&self, scene: &Scene) -> CameraSampler {
+        CameraSampler::new(self.seed, self.pixel_samples.clone())
+            .with_lens_samples(scene.camera.has_lens())
+    }
+
     /// The film the passes accumulate in.
     #[cfg(test)]
     pub(crate) fn film(&self) -> &Film {
@@ -242,7 +315,7 @@ impl<S: CameraSampleFn + Send> Estimator for CameraEstimator<S> {
             self.seed,
             first..first + count,
             &self.pixel_samples,
-            &self.sample,
+            &mut self.sample,
         );
         self.stats.passes += count as u64;
         self.stats.samples += counts.samples;
@@ -251,11 +324,24 @@ impl<S: CameraSampleFn + Send> Estimator for CameraEstimator<S> {
     }
 
     fn image(&self) -> Image {
-        self.film.image(0.0)
+        if self.sample.splats() {
+            // One light subpath per camera sample.
+            self.film.image_with_light_paths(self.stats.samples)
+        } else {
+            self.film.image(0.0)
+        }
     }
 
     fn stats(&self) -> Stats {
         self.stats.clone()
+    }
+
+    fn keeps_strategy_images(&self) -> bool {
+        self.sample.keeps_strategy_images()
+    }
+
+    fn strategy_images(&self) -> Option<Vec<StrategyImage>> {
+        self.sample.strategy_images(&self.film, self.stats.samples)
     }
 }
 

@@ -52,7 +52,18 @@ pub struct Shade {
 }
 
 impl CameraSampleFn for Shade {
-    fn radiance(&self, scene: &Scene, ray: &Ray, _: &mut CameraSampler) -> (Rgb, u64) {
+    type Scratch<'a> = ();
+    type Extra = ();
+
+    fn radiance(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        _raster: glam::Vec2,
+        _sampler: &mut CameraSampler,
+        _scratch: &mut (),
+        _extra: &mut (),
+    ) -> (Rgb, u64) {
         let mut ray = *ray;
         for crossing in 0..=MAX_NULL_CROSSINGS {
             let Some(hit) = scene.geometry.intersect(&ray) else {

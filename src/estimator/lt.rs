@@ -4,7 +4,7 @@
 //! t = 1 strategies only, each with weight 1).
 //!
 //! * A pass traces as many light paths as the film (window) has pixels, so `--spp N`
-//!   means N × pixels paths (DESIGN.md §3). The image is the splats times pixels / paths:
+//!   means N × pixels paths (docs/DESIGN.md §3). The image is the splats times pixels / paths:
 //!   the camera's importance is normalised over the whole window, so a pixel's share of a
 //!   path's contribution is 1/pixels of its measurement.
 //! * Lights are chosen by power (`LightSet::sample`), a ray leaves the chosen light by
@@ -27,19 +27,21 @@
 use glam::Vec2;
 use rayon::prelude::*;
 
-use super::pt::PtSettings;
 use super::{Estimator, Stats};
 use crate::error::Result;
 use crate::film::{Film, SplatList};
 use crate::image::Image;
 use crate::material::TransportMode;
-use crate::path::camera_connection::{self, CameraSplat, adjoint_shading_factor};
-use crate::path::random_walk::emitted_ray;
-use crate::sampler::{IndependentSampler, Sampler};
+use crate::path::camera_connection::{self, CameraSplat};
+use crate::path::random_walk::{Step, Walk, WalkHook, random_walk};
+use crate::path::settings::PathSettings;
+use crate::path::subpath::start_light;
+use crate::path::vertex::{Vertex, VertexKind};
+use crate::sampler::{IndependentSampler, Sampler, Stream};
 use crate::scene::Scene;
 
-/// `lt` reads the same settings as `pt`: `max_depth`, `rr_depth`, `hide_emitters`.
-pub type LtSettings = PtSettings;
+/// `lt` reads the path settings: `max_depth`, `rr_depth`, `hide_emitters`.
+pub type LtSettings = PathSettings;
 
 /// Light paths per block: the unit of parallel work and of the merge order.
 const PATHS_PER_BLOCK: u64 = 4096;
@@ -83,7 +85,7 @@ struct BlockCounts {
 }
 
 impl LightTracer {
-    /// Traces light path number `index` of pass `pass`, recording its splats.
+    /// Traces one light path from `sampler`'s current sample, recording its splats.
     fn trace(
         &self,
         scene: &Scene,
@@ -91,83 +93,43 @@ impl LightTracer {
         splats: &mut SplatList,
         counts: &mut BlockCounts,
     ) {
-        let max_depth = self.settings.max_depth.unwrap_or(u32::MAX);
+        let max_depth = self.settings.max_segments();
         if max_depth == 0 {
             return;
         }
-        let has_lens = scene.camera.has_lens();
-        // The lens point of each connection (a pinhole draws none).
-        let lens_sample = |s: &mut IndependentSampler| {
-            if has_lens { s.next_2d() } else { Vec2::ZERO }
-        };
-        let Some((index, pmf, _)) = scene.lights.sample(sampler.next_1d()) else {
+        sampler.start_stream(Stream::Light);
+        let Some(start) = start_light(scene, sampler) else {
             return;
         };
-        let light = scene.lights.get(index);
-        let (u_pos, u_dir) = (sampler.next_2d(), sampler.next_2d());
-        let Some(e) = light.sample_le(u_pos, u_dir) else {
-            return;
-        };
-
         // s = 1: the light seen by the camera (a path of one segment).
-        let u_lens = lens_sample(sampler);
+        let u_lens = lens_sample(scene, sampler);
         if !self.settings.hide_emitters
-            && let Some(splat) = camera_connection::connect_emitter(scene, light, pmf, &e, u_lens)
+            && let Some(splat) = camera_connection::connect_emitter(
+                scene,
+                scene.lights.get(start.light),
+                start.pmf,
+                &start.emission,
+                u_lens,
+            )
         {
             self.record(scene, &splat, splats, counts);
         }
-
-        let (mut ray, mut beta) = emitted_ray(&e, pmf);
-        let mut eta = 1.0f32;
-        // Segments of the light path so far, the one being traced included.
-        let mut depth = 1u32;
-        loop {
-            counts.rays += 1;
-            let Some(si) = scene.geometry.intersect(&ray) else {
-                break;
-            };
-            // Joining `si` to the camera makes a path of depth + 1 segments.
-            if depth >= max_depth {
-                break;
-            }
-            let wo = -ray.d.normalize();
-            let bsdf = &*scene.bsdf_at(&si);
-            let frame = si.frame();
-            if bsdf.has_non_delta() {
-                let u_lens = lens_sample(sampler);
-                if let Some(splat) =
-                    camera_connection::connect_surface(scene, &si, &frame, bsdf, wo, beta, u_lens)
-                {
-                    self.record(scene, &splat, splats, counts);
-                }
-            }
-
-            // The next segment, by importance-transport BSDF sampling.
-            let u_lobe = sampler.next_1d();
-            let u = sampler.next_2d();
-            let Some(bs) = bsdf.sample(frame.to_local(wo), u_lobe, u, TransportMode::Importance)
-            else {
-                break;
-            };
-            let wi = frame.to_world(bs.wi);
-            beta *= bs.weight * adjoint_shading_factor(wo, wi, si.ns, si.ng);
-            eta *= bs.eta;
-            ray = si.spawn_ray(wi);
-            depth += 1;
-
-            // Russian roulette, as `pt`.
-            let max_beta = beta.max_component();
-            if max_beta <= 0.0 || !max_beta.is_finite() {
-                break;
-            }
-            if depth > self.settings.rr_depth {
-                let q = (max_beta * eta * eta).min(0.95);
-                if sampler.next_1d() >= q {
-                    break;
-                }
-                beta /= q;
-            }
-        }
+        let mut hook = CameraJoin {
+            tracer: self,
+            scene,
+            splats,
+            counts,
+            max_depth,
+        };
+        let rays = random_walk(
+            scene,
+            start.walk(),
+            TransportMode::Importance,
+            self.settings.rr_depth,
+            sampler,
+            &mut hook,
+        );
+        hook.counts.rays += rays;
     }
 
     /// Casts `splat`'s shadow ray and keeps it if the camera sees its vertex; a value that
@@ -186,6 +148,54 @@ impl LightTracer {
         counts.rays += 1;
         if !scene.geometry.occluded(&splat.shadow) {
             splats.push(splat.raster, splat.value);
+        }
+    }
+}
+
+/// The lens point of a connection to the camera, drawn from the connection stream (two
+/// numbers for a thin lens, none for a pinhole).
+fn lens_sample(scene: &Scene, sampler: &mut impl Sampler) -> Vec2 {
+    if !scene.camera.has_lens() {
+        return Vec2::ZERO;
+    }
+    sampler.start_stream(Stream::Connect);
+    let u = sampler.next_2d();
+    sampler.start_stream(Stream::Light);
+    u
+}
+
+/// Joins every vertex of a light walk to the camera (the walk's hook).
+struct CameraJoin<'t, 'o> {
+    tracer: &'t LightTracer,
+    scene: &'t Scene,
+    splats: &'o mut SplatList,
+    counts: &'o mut BlockCounts,
+    max_depth: u32,
+}
+
+impl<'a> WalkHook<'a> for CameraJoin<'_, '_> {
+    fn arrive(&mut self, v: &Vertex<'a>, walk: &Walk, sampler: &mut impl Sampler) -> Step {
+        // Joining `v` to the camera makes a path of the emitted segment, the walk's
+        // scatterings and the connection.
+        let segments = walk.depth.saturating_add(2);
+        if segments > self.max_depth {
+            return Step::Stop;
+        }
+        let u_lens = lens_sample(self.scene, sampler);
+        if let VertexKind::Surface { si, bsdf, frame } = &v.kind
+            && v.is_connectible()
+            && let Some(splat) = camera_connection::connect_surface(
+                self.scene, si, frame, bsdf, v.wo, walk.beta, u_lens,
+            )
+        {
+            self.tracer
+                .record(self.scene, &splat, self.splats, self.counts);
+        }
+        // The next vertex would make a path too long.
+        if segments == self.max_depth {
+            Step::Stop
+        } else {
+            Step::Continue
         }
     }
 }

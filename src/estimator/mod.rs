@@ -1,4 +1,4 @@
-//! Estimators: interchangeable ways of estimating the pixel integrals (DESIGN.md §3).
+//! Estimators: interchangeable ways of estimating the pixel integrals (docs/DESIGN.md §3).
 //!
 //! An estimator is progressive: each `run_pass` adds work, `image` is the current estimate.
 //! Every random number is drawn from a seed-keyed `Sampler`, and work is cut into pieces that

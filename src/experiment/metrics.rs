@@ -1,4 +1,4 @@
-//! Error metrics of an image against a reference, exactly as DESIGN.md §5 defines them, over
+//! Error metrics of an image against a reference, exactly as docs/DESIGN.md §5 defines them, over
 //! all pixels and the three channels, computed in f64:
 //!
 //! - relMSE = mean((x − y)² / (y² + 0.01))
@@ -13,11 +13,11 @@ use serde::{Deserialize, Serialize};
 use crate::error::{Error, Result};
 use crate::image::Image;
 
-/// The constant in the relMSE and MAPE denominators (DESIGN.md §5): keeps black reference
+/// The constant in the relMSE and MAPE denominators (docs/DESIGN.md §5): keeps black reference
 /// pixels from dividing by zero.
 pub const EPSILON: f64 = 0.01;
 
-/// The three DESIGN.md §5 errors of one image against a reference.
+/// The three docs/DESIGN.md §5 errors of one image against a reference.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
     pub relmse: f64,
@@ -97,7 +97,7 @@ fn metrics_over(image: &Image, reference: &Image, region: Region) -> Result<Metr
 }
 
 /// Per-pixel relative error for false-colour maps: the channel mean of |x − y| / (y + 0.01)
-/// (the MAPE term of DESIGN.md §5), row-major like `Image::pixels`.
+/// (the MAPE term of docs/DESIGN.md §5), row-major like `Image::pixels`.
 pub fn relative_error_map(image: &Image, reference: &Image) -> Result<Vec<f32>> {
     check_pair(image, reference, "image", "reference")?;
     let mut map = Vec::with_capacity(reference.pixels.len());

@@ -1,4 +1,4 @@
-//! The experiment harness (DESIGN.md §5–6): named experiments pit estimators against a long
+//! The experiment harness (docs/DESIGN.md §5–6): named experiments pit estimators against a long
 //! reference at equal time or equal work, over independent runs, and report errors,
 //! convergence slopes, efficiency, bias and variance as CSV, JSON, plots and a README.
 //!

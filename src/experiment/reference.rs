@@ -20,7 +20,7 @@ use crate::image::Image;
 use crate::io::atomic::write_file_atomically;
 use crate::io::exr::{read_exr, write_exr};
 use crate::io::png::write_png_preview;
-use crate::render::Budget;
+use crate::render::{Budget, Progress, advance};
 use crate::sampler::independent::hash_words;
 use crate::scene::Scene;
 
@@ -83,18 +83,18 @@ pub fn render_reference(
         Budget::Passes(p) => Budget::Passes(p.div_ceil(2)),
         seconds => seconds,
     };
+    // Both halves take every chunk of passes in turn (`render::advance`), so that a stop
+    // request leaves them at the same pass.
     let start = Instant::now();
-    let mut pass = 0u32;
-    loop {
-        if per_half.is_spent(pass, start) || (pass > 0 && crate::interrupt::requested()) {
-            break;
+    let mut progress = Progress::default();
+    let run_both = |first, count| {
+        for half in estimators.iter_mut() {
+            half.run_passes(scene, first, count);
         }
-        for (half, est) in estimators.iter_mut().enumerate() {
-            est.run_pass(scene, pass);
-            on_pass(half, pass + 1);
-        }
-        pass += 1;
-    }
+    };
+    advance(run_both, per_half, &mut progress, true, |p| {
+        on_pass(1, p.passes)
+    });
     let seconds = start.elapsed().as_secs_f64();
     let (mut passes, mut samples) = (0u64, 0u64);
     let mut halves = Vec::new();

@@ -338,7 +338,7 @@ pub fn report(
     Ok(summary)
 }
 
-/// `metrics.csv` with exactly DESIGN.md §6's columns.
+/// `metrics.csv` with exactly docs/DESIGN.md §6's columns.
 fn write_metrics_csv(path: &Path, rows: &[Row]) -> Result<()> {
     let mut text =
         String::from("estimator,run,checkpoint,seconds,passes,samples,relmse,rmse,mape\n");
@@ -534,7 +534,7 @@ fn readme(
          t interval's coverage. \
          Slope: least squares of log relMSE (mean over runs) against log time over the later half of \
          the checkpoints (−1 for an unbiased estimator). Efficiency = 1 / (relMSE × seconds). \
-         Relative bias² and variance: DESIGN.md §5 across runs, each pixel term divided by \
+         Relative bias² and variance: docs/DESIGN.md §5 across runs, each pixel term divided by \
          (y² + 0.01) as relMSE is; the t-test asks whether the mean signed error is 0. The \
          reference's own error enters (m − y)² as well, so a bias² whose interval reaches down \
          to the reference's noise cannot be told from zero (marked \"within ref. noise\").\n"

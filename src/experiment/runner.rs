@@ -1,7 +1,7 @@
 //! Running an experiment's cells: each (estimator, run) renders with its own seed, stops
 //! at log-spaced checkpoints, and measures its image against the reference there.
 //!
-//! Files under `results/NAME/` (DESIGN.md §6), each written atomically:
+//! Files under `results/NAME/` (docs/DESIGN.md §6), each written atomically:
 //! * `cells/LABEL-runR.csv`: the cell's rows so far (one per checkpoint and region; the
 //!   whole image is region ""), rewritten after every checkpoint;
 //! * `checkpoints/LABEL/runR-cpK.exr`: the image at each checkpoint (bias and variance are
@@ -16,7 +16,6 @@
 //! are retaken.
 
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 use indicatif::ProgressBar;
 
@@ -29,11 +28,11 @@ use crate::image::Image;
 use crate::io::atomic::write_file_atomically;
 use crate::io::exr::write_exr;
 use crate::io::png::write_png_preview;
-use crate::render::Budget;
+use crate::render::{Budget, Progress, advance};
 use crate::sampler::independent::hash_words;
 use crate::scene::{Scene, mitsuba};
 
-/// The header of `metrics.csv` and of every cell file (DESIGN.md §6, plus `region`).
+/// The header of `metrics.csv` and of every cell file (docs/DESIGN.md §6, plus `region`).
 pub const CSV_HEADER: &str =
     "estimator,run,checkpoint,seconds,passes,samples,region,relmse,rmse,mape";
 
@@ -532,8 +531,7 @@ pub fn run_cell(
         .collect();
 
     let mut rows = Vec::new();
-    let mut seconds = 0.0f64;
-    let mut pass = 0u32;
+    let mut progress = Progress::default();
     let mut image = Image::new(scene.width(), scene.height());
     for (k, budget) in budgets.iter().enumerate() {
         bar.set_message(format!(
@@ -545,24 +543,17 @@ pub fn run_cell(
             k + 1,
             budgets.len()
         ));
-        loop {
-            let reached = match *budget {
-                Budget::Passes(p) => pass >= p,
-                Budget::Seconds(s) => pass > 0 && seconds >= s,
-            };
-            if reached {
-                break;
-            }
-            let start = Instant::now();
-            est.run_pass(scene, pass);
-            let dt = start.elapsed().as_secs_f64();
-            seconds += dt;
-            pass += 1;
+        // Passes in chunks, as `render` takes them (`render::advance`).
+        let (mut passes, mut seconds) = (progress.passes, progress.seconds);
+        let passes_of = |first, count| est.run_passes(scene, first, count);
+        advance(passes_of, *budget, &mut progress, false, |p| {
             match experiment.budget {
-                Budget::Passes(_) => bar.inc(1),
-                Budget::Seconds(_) => bar.inc((dt * 1000.0) as u64),
+                Budget::Passes(_) => bar.inc((p.passes - passes) as u64),
+                Budget::Seconds(_) => bar.inc(((p.seconds - seconds) * 1000.0) as u64),
             }
-        }
+            (passes, seconds) = (p.passes, p.seconds);
+        });
+        let seconds = progress.seconds;
         image = est.image();
         let stats = est.stats();
         let row = |region: &str, m: super::metrics::Metrics| Row {

@@ -1,4 +1,4 @@
-//! Statistics reported over runs and checkpoints (DESIGN.md §5): Student-t confidence
+//! Statistics reported over runs and checkpoints (docs/DESIGN.md §5): Student-t confidence
 //! intervals of a mean, the convergence slope (a power law fitted in log-log space), and the
 //! bias/variance decomposition over independent runs with a t-test of zero mean signed error.
 //! Everything is f64; bad input gives an error or a documented degenerate value, never a panic.
@@ -208,14 +208,14 @@ pub fn fit_power_law(x: &[f64], y: &[f64]) -> Option<SlopeFit> {
     })
 }
 
-/// The later half of a sequence of checkpoints, over which DESIGN.md §5 fits the convergence
+/// The later half of a sequence of checkpoints, over which docs/DESIGN.md §5 fits the convergence
 /// slope (early checkpoints are dominated by start-up, not by the asymptotic rate): the last
 /// ⌈n/2⌉ items, so with an odd count the middle checkpoint is included.
 pub fn later_half<T>(values: &[T]) -> &[T] {
     &values[values.len() / 2..]
 }
 
-/// `fit_power_law` over the later half of the checkpoints (DESIGN.md §5's convergence slope).
+/// `fit_power_law` over the later half of the checkpoints (docs/DESIGN.md §5's convergence slope).
 pub fn fit_later_half(x: &[f64], y: &[f64]) -> Option<SlopeFit> {
     if x.len() != y.len() {
         return None;
@@ -224,7 +224,7 @@ pub fn fit_later_half(x: &[f64], y: &[f64]) -> Option<SlopeFit> {
 }
 
 /// Bias and variance of an estimator from K independent runs against a reference
-/// (DESIGN.md §5), each with a `CONFIDENCE` interval.
+/// (docs/DESIGN.md §5), each with a `CONFIDENCE` interval.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
 pub struct BiasVariance {
     /// mean over pixel-channels of (m − y)² − s²/K: squared bias, in squared radiance.

@@ -26,7 +26,7 @@ const LANES: usize = 16;
 /// Scenes with at most this many triangles (three chunks) are answered by `FlatTriangles`.
 /// `cargo bench --bench rays -- flat_crossover` (one thread, incoherent rays): at 36
 /// triangles flat closest hits run 13% faster than the tree's, at 68 closest hits are 4%
-/// faster and any hits 14% slower, at 132 both are 1.5–2× slower (README "Performance").
+/// faster and any hits 14% slower, at 132 both are 1.5–2× slower (`docs/performance.md`).
 pub const FLAT_LIMIT: usize = 48;
 
 /// Sixteen triangles, coordinates by axis, then vertex, then lane.

@@ -7,7 +7,7 @@
 //! integrand lets jittered sampling reach N⁻² in 2D.
 //!
 //! Those rates are asymptotic, so slopes are fitted over the later half of each pattern's
-//! point counts (`fit_later_half`, DESIGN.md §5's rule for convergence slopes). Poisson disk
+//! point counts (`fit_later_half`, docs/DESIGN.md §5's rule for convergence slopes). Poisson disk
 //! needs it most. With P(ν) the expected power spectrum of the points (P = 1 for random
 //! points), Pilleboue et al.'s Var = (1/N)·Σ_{ν≠0} |f̂(ν)|² P(ν); dart throwing leaves a
 //! low-frequency plateau P₀ > 0 (≈ 0.06 at `poisson::RELATIVE_RADIUS` = 0.75) inside its

@@ -21,6 +21,7 @@ use crate::material::TransportMode;
 use crate::math::Rgb;
 use crate::path::camera_connection::{self, adjoint_shading_factor};
 use crate::path::mis::{Heuristic, PathDensity, StrategyRules, strategy_weight};
+use crate::path::next_event::{self, LightChoice};
 use crate::path::subpath::LightStart;
 use crate::path::vertex::{Vertex, VertexKind};
 use crate::sampler::Sampler;
@@ -77,11 +78,11 @@ pub fn connect<'a>(
     };
     if s == 1 {
         // Next-event estimation from z(t−1).
-        let u_light = sampler.next_1d();
-        let u = sampler.next_2d();
-        let (index, pmf, _) = scene.lights.sample(u_light)?;
-        let light = scene.lights.get(index);
-        let ls = light.sample_li(si_pt.p, u)?;
+        let LightChoice {
+            light: index,
+            pmf,
+            sample: ls,
+        } = next_event::sample_light(scene, si_pt.p, sampler)?;
         let f = bsdf_pt.eval(
             frame_pt.to_local(pt.wo),
             frame_pt.to_local(ls.wi),
@@ -89,21 +90,15 @@ pub fn connect<'a>(
         );
         let cos = ls.wi.dot(si_pt.ns).abs();
         let value = pt.beta * f * ls.radiance * (cos / (pmf * ls.pdf_solid_angle));
-        let (mut vertex, shadow) = if ls.dist.is_finite() {
-            (
-                Vertex::light(index, ls.delta, ls.p, ls.n, ls.radiance, 0.0),
-                si_pt.spawn_ray_to_surface(ls.p, ls.p_error, ls.n),
-            )
+        let mut vertex = if ls.dist.is_finite() {
+            Vertex::light(index, ls.delta, ls.p, ls.n, ls.radiance, 0.0)
         } else {
-            (
-                Vertex::at_infinity(Some(index), ls.delta, ls.wi, ls.radiance),
-                si_pt.spawn_ray(ls.wi),
-            )
+            Vertex::at_infinity(Some(index), ls.delta, ls.wi, ls.radiance)
         };
         vertex.pdf_fwd = vertex.pdf_light_origin(scene, -ls.wi);
         return Some(Connection {
             value,
-            shadow: Some(shadow),
+            shadow: Some(next_event::shadow_ray(si_pt, &ls)),
             raster: None,
             sampled: Some(Sampled {
                 vertex,

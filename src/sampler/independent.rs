@@ -39,7 +39,7 @@ impl IndependentSampler {
 
     /// Re-seeds the stream from any list of words (used for non-pixel streams such as
     /// light paths, keyed by pass and piece).
-    pub fn start_stream(&mut self, key: &[u64]) {
+    pub fn start_keyed(&mut self, key: &[u64]) {
         let mut words = Vec::with_capacity(key.len() + 1);
         words.push(self.seed);
         words.extend_from_slice(key);
@@ -75,12 +75,16 @@ pub(crate) fn to_unit_f32(bits: u64) -> f32 {
     (bits >> 40) as f32 * (1.0 / (1u64 << 24) as f32)
 }
 
-impl Sampler for IndependentSampler {
-    fn start_pixel_sample(&mut self, pixel: (u32, u32), sample_index: u64) {
+impl IndependentSampler {
+    /// Starts the sample with index `sample_index` of pixel `pixel`: what follows depends
+    /// only on (seed, pixel, sample_index), never on the thread that runs it.
+    pub fn start_pixel_sample(&mut self, pixel: (u32, u32), sample_index: u64) {
         let key = hash_words(&[self.seed, pixel.0 as u64, pixel.1 as u64, sample_index]);
         self.rng = Xoshiro256PlusPlus::seed_from_u64(key);
     }
+}
 
+impl Sampler for IndependentSampler {
     fn next_1d(&mut self) -> f32 {
         to_unit_f32(self.rng.next_u64())
     }

@@ -19,10 +19,33 @@ pub use independent::IndependentSampler;
 
 use glam::Vec2;
 
+/// The streams of a sample: what a sampler may keep apart, so that the numbers of one do not
+/// shift when another draws more or fewer (a light subpath's length must not move the camera
+/// subpath's dimensions in a Metropolis sampler's primary sample space).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stream {
+    /// The camera sample (its first 2D draw is the raster position within the sample's
+    /// area, then the lens point for a thin lens) and the camera subpath.
+    Camera,
+    /// The light subpath: the light's choice, its emission, the walk.
+    Light,
+    /// What joins the two subpaths: light points of next-event estimation from the camera
+    /// subpath, lens points of light-tracing connections.
+    Connect,
+}
+
+/// The sampler contract: estimators only draw numbers and say which stream they draw from.
+/// Where a sample starts (the pixel, the pass, the seed) is the concrete sampler's business
+/// (`IndependentSampler::start_pixel_sample`, `CameraSampler::start_pixel_sample`): an
+/// estimator written against this trait runs unchanged on a Metropolis sampler.
+///
+/// Every estimator draws a fixed number of dimensions per vertex whatever happens there (a
+/// specular vertex still consumes its next-event numbers, Russian roulette its number before
+/// `rr_depth`), so that dimension k means the same thing from one sample to the next.
 pub trait Sampler {
-    /// Starts the sample with index `sample_index` of pixel `pixel`; what follows depends
-    /// only on (seed, pixel, sample_index), never on the thread that runs it.
-    fn start_pixel_sample(&mut self, pixel: (u32, u32), sample_index: u64);
+    /// Starts drawing from `stream`. The independent samplers draw every stream from one
+    /// random sequence: for them this does nothing.
+    fn start_stream(&mut self, _stream: Stream) {}
 
     /// A uniform number in [0, 1).
     fn next_1d(&mut self) -> f32;

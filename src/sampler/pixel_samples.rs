@@ -204,10 +204,10 @@ impl CameraSampler {
     pub fn stream_state(&self) -> [u64; 4] {
         self.rng.state()
     }
-}
 
-impl Sampler for CameraSampler {
-    fn start_pixel_sample(&mut self, pixel: (u32, u32), sample_index: u64) {
+    /// Starts sample `sample_index` of pixel `pixel` (see `IndependentSampler`): the pixel
+    /// and lens positions of the pattern are the first 2D draws that follow.
+    pub fn start_pixel_sample(&mut self, pixel: (u32, u32), sample_index: u64) {
         self.rng.start_pixel_sample(pixel, sample_index);
         self.handed_out = 0;
         self.pending[0] = self.pixel_samples.offset(self.seed, pixel, sample_index);
@@ -217,7 +217,9 @@ impl Sampler for CameraSampler {
             None
         };
     }
+}
 
+impl Sampler for CameraSampler {
     fn next_1d(&mut self) -> f32 {
         self.rng.next_1d()
     }

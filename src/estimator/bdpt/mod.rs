@@ -19,34 +19,30 @@ mod strategy_images;
 pub use strategy_images::{StrategyImage, StrategyImages};
 
 use glam::Vec2;
-use rayon::prelude::*;
 
-use super::pt::PtSettings;
-use super::{Estimator, Params, Stats};
+use super::Params;
+use super::camera_pass::{CameraEstimator, CameraSampleFn, start_camera_sample};
 use crate::error::{Error, Result};
-use crate::film::{Film, FilmTile, SplatList};
+use crate::film::{Film, SplatList};
 use crate::geometry::Ray;
-use crate::image::Image;
 use crate::math::Rgb;
 use crate::path::connection::{self, Sampled};
 pub use crate::path::mis::Heuristic;
 use crate::path::mis::PathDensity;
-use crate::path::random_walk::WalkLimits;
+use crate::path::settings::PathSettings;
 use crate::path::subpath::{camera_subpath, light_subpath};
 use crate::path::vertex::Vertex;
-use crate::sampler::pixel_samples::{CameraSampler, PixelSamples};
+use crate::sampler::pixel_samples::CameraSampler;
+use crate::sampler::{Sampler, Stream};
 use crate::scene::Scene;
-use std::sync::Arc;
-
-use super::camera_pass::{TILE_SIZE, start_camera_sample};
 
 /// The longest path length `strategies_max_depth` may ask for: (L + 1)(L + 2) − 2 images.
 const MAX_STRATEGIES_DEPTH: u32 = 16;
 
-/// `bdpt`'s settings: `pt`'s three, `mis`, and the strategy images.
+/// `bdpt`'s settings: the path settings, `mis`, and the strategy images.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BdptSettings {
-    pub path: PtSettings,
+    pub path: PathSettings,
     pub mis: Heuristic,
     /// Also write one image per strategy (s, t), weighted and unweighted (`render` only).
     pub strategies: bool,
@@ -56,7 +52,7 @@ pub struct BdptSettings {
 
 impl BdptSettings {
     pub fn from_params(params: &Params, scene: &Scene) -> Result<BdptSettings> {
-        let path = PtSettings::from_params(params, scene)?;
+        let path = PathSettings::from_params(params, scene)?;
         let mis = match params.get("mis", "balance".to_string())?.as_str() {
             "balance" => Heuristic::Balance,
             "power" => Heuristic::Power,
@@ -83,16 +79,8 @@ impl BdptSettings {
     }
 }
 
-/// The `bdpt` estimator.
-pub struct Bdpt {
-    film: Film,
-    seed: u64,
-    settings: BdptSettings,
-    stats: Stats,
-    pixel_samples: Arc<PixelSamples>,
-    /// With `strategies=true`.
-    strategy_images: Option<StrategyImages>,
-}
+/// The `bdpt` estimator: camera samples (`camera_pass`) of `BdptSample`.
+pub type Bdpt = CameraEstimator<BdptSample>;
 
 /// Makes `bdpt` for `scene`; an error for a film too large.
 pub fn new(scene: &Scene, seed: u64, settings: BdptSettings) -> Result<Bdpt> {
@@ -109,28 +97,22 @@ pub fn new(scene: &Scene, seed: u64, settings: BdptSettings) -> Result<Bdpt> {
     } else {
         None
     };
-    Ok(Bdpt {
-        film: Film::new(width, height, film.filter)?,
+    CameraEstimator::new(
+        "bdpt",
+        scene,
         seed,
-        settings,
-        stats: Stats::default(),
-        pixel_samples: Arc::new(PixelSamples::Independent),
-        strategy_images,
-    })
+        BdptSample {
+            settings,
+            strategy_images,
+        },
+    )
 }
 
-impl Bdpt {
-    /// Places the camera samples inside their pixels with `pixel_samples`.
-    pub fn with_pixel_samples(mut self, pixel_samples: PixelSamples) -> Self {
-        self.pixel_samples = Arc::new(pixel_samples);
-        self
-    }
-
-    /// The strategy images so far (with `strategies=true`).
-    pub fn strategy_images(&self) -> Option<Vec<StrategyImage>> {
-        let images = self.strategy_images.as_ref()?;
-        Some(images.images(&self.film, self.stats.samples))
-    }
+/// One camera sample of `bdpt`: both subpaths, every strategy.
+pub struct BdptSample {
+    settings: BdptSettings,
+    /// With `strategies=true`.
+    strategy_images: Option<StrategyImages>,
 }
 
 /// What one strategy contributed to one camera sample: the path it made, its weight and
@@ -150,39 +132,35 @@ pub struct StrategyEvent<'p, 'a> {
     pub raster: Option<Vec2>,
 }
 
-/// What one tile of one pass produced.
-struct TileResult {
-    tile: FilmTile,
+/// What a tile's samples add beyond their pixels.
+#[derive(Default)]
+pub struct BdptTile {
+    /// Light tracing's contributions (t = 1), in the order they were made.
     splats: SplatList,
-    rays: u64,
+    /// Contributions dropped as not finite.
     invalid: u64,
     /// The strategy images' share (with `strategies=true`).
     strategies: strategy_images::TileRecords,
 }
 
-/// Per-thread buffers reused by every camera sample: no allocation per sample.
+/// Buffers reused by every camera sample of a tile: no allocation per sample.
 #[derive(Default)]
-struct Scratch<'a> {
+pub struct Scratch<'a> {
     camera_path: Vec<Vertex<'a>>,
     light_path: Vec<Vertex<'a>>,
     densities: Vec<PathDensity>,
 }
 
-impl Bdpt {
-    fn walk_limits(&self, light: bool) -> WalkLimits {
-        let max_depth = self
-            .settings
-            .path
-            .max_depth
-            .map_or(usize::MAX / 4, |d| d as usize);
-        WalkLimits {
-            // The light's own vertex counts on the light side.
-            max_vertices: if light {
-                max_depth.saturating_sub(1)
-            } else {
-                max_depth
-            },
-            rr_depth: self.settings.path.rr_depth,
+impl BdptSample {
+    /// The most vertices a walk adds to a subpath: `max_depth` on the camera side (the
+    /// camera point and those vertices make paths of at most `max_depth` segments), one
+    /// fewer on the light side, whose light vertex counts.
+    fn max_walk_vertices(&self, light: bool) -> usize {
+        let max_depth = self.settings.path.max_segments() as usize;
+        if light {
+            max_depth.saturating_sub(1)
+        } else {
+            max_depth
         }
     }
 
@@ -207,11 +185,18 @@ impl Bdpt {
             densities,
         } = scratch;
         let (rays, invalid) = counts;
-        *rays += camera_subpath(scene, ray, sampler, self.walk_limits(false), camera_path);
-        let (start, light_rays) = light_subpath(scene, sampler, self.walk_limits(true), light_path);
+        let rr_depth = self.settings.path.rr_depth;
+        let camera_vertices = self.max_walk_vertices(false);
+        // The camera stream began with the camera sample's raster position.
+        *rays += camera_subpath(scene, ray, camera_vertices, rr_depth, sampler, camera_path);
+        sampler.start_stream(Stream::Light);
+        let light_vertices = self.max_walk_vertices(true);
+        let (start, light_rays) =
+            light_subpath(scene, light_vertices, rr_depth, sampler, light_path);
         *rays += light_rays;
+        sampler.start_stream(Stream::Connect);
         let settings = &self.settings;
-        let max_vertices = self.walk_limits(false).max_vertices.saturating_add(1);
+        let max_vertices = camera_vertices.saturating_add(1);
         let mut pixel = Rgb::BLACK;
         for t in 1..=camera_path.len() {
             for s in 0..=light_path.len() {
@@ -277,7 +262,9 @@ impl Bdpt {
         }
         pixel
     }
+}
 
+impl Bdpt {
     /// Runs the camera sample `index` of pixel (x, y) as `run_pass` does for pass `index`
     /// (the same random numbers), calling `observe` for every strategy that contributes,
     /// including those of weight 0. For tests and diagnostics.
@@ -288,13 +275,11 @@ impl Bdpt {
         index: u32,
         mut observe: impl FnMut(&StrategyEvent),
     ) {
-        let camera = &scene.camera;
-        let mut sampler = CameraSampler::new(self.seed, self.pixel_samples.clone())
-            .with_lens_samples(camera.has_lens());
-        let (_, ray) = start_camera_sample(camera, &mut sampler, x, y, index);
+        let mut sampler = self.camera_sampler(scene);
+        let (_, ray) = start_camera_sample(&scene.camera, &mut sampler, x, y, index);
         let mut scratch = Scratch::default();
         let mut splats = SplatList::new();
-        self.sample(
+        self.sample_fn().sample(
             scene,
             ray,
             &mut sampler,
@@ -305,108 +290,71 @@ impl Bdpt {
             &mut observe,
         );
     }
-
-    /// One tile of one pass.
-    fn render_tile(
-        &self,
-        scene: &Scene,
-        rect: crate::film::PixelRect,
-        pass_index: u32,
-    ) -> TileResult {
-        let mut out = TileResult {
-            tile: self.film.tile(rect),
-            splats: SplatList::new(),
-            rays: 0,
-            invalid: 0,
-            strategies: strategy_images::TileRecords::default(),
-        };
-        let camera = &scene.camera;
-        let mut sampler = CameraSampler::new(self.seed, self.pixel_samples.clone())
-            .with_lens_samples(camera.has_lens());
-        let mut scratch = Scratch::default();
-        let mut counts = (0u64, 0u64);
-        for y in rect.y0..rect.y1 {
-            for x in rect.x0..rect.x1 {
-                let (raster, ray) = start_camera_sample(camera, &mut sampler, x, y, pass_index);
-                let value = match &self.strategy_images {
-                    None => self.sample(
-                        scene,
-                        ray,
-                        &mut sampler,
-                        &mut scratch,
-                        &mut out.splats,
-                        &mut counts,
-                        false,
-                        |_| {},
-                    ),
-                    Some(images) => {
-                        let records = &mut out.strategies;
-                        records.start_sample();
-                        let value = self.sample(
-                            scene,
-                            ray,
-                            &mut sampler,
-                            &mut scratch,
-                            &mut out.splats,
-                            &mut counts,
-                            true,
-                            |e| records.record(images, e, raster),
-                        );
-                        records.end_sample(value.is_valid_radiance());
-                        value
-                    }
-                };
-                if value.is_valid_radiance() {
-                    out.tile.add_sample(raster, value);
-                } else {
-                    counts.1 += 1;
-                }
-            }
-        }
-        (out.rays, out.invalid) = counts;
-        out
-    }
 }
 
-impl Estimator for Bdpt {
-    fn name(&self) -> &str {
-        "bdpt"
-    }
+impl CameraSampleFn for BdptSample {
+    type Scratch<'a> = Scratch<'a>;
+    type Extra = BdptTile;
 
-    fn run_pass(&mut self, scene: &Scene, pass_index: u32) {
-        let rects = self.film.tiles(TILE_SIZE);
-        let results: Vec<TileResult> = rects
-            .par_iter()
-            .map(|&rect| self.render_tile(scene, rect, pass_index))
-            .collect();
-        for r in results {
-            self.film.merge_tile(&r.tile);
-            self.film.merge_splats(&r.splats);
-            if let Some(images) = &mut self.strategy_images {
-                images.merge(&r.strategies);
+    fn radiance<'a>(
+        &self,
+        scene: &'a Scene,
+        ray: &Ray,
+        raster: Vec2,
+        sampler: &mut CameraSampler,
+        scratch: &mut Scratch<'a>,
+        tile: &mut BdptTile,
+    ) -> (Rgb, u64) {
+        let mut counts = (0u64, 0u64);
+        let value = match &self.strategy_images {
+            None => self.sample(
+                scene,
+                *ray,
+                sampler,
+                scratch,
+                &mut tile.splats,
+                &mut counts,
+                false,
+                |_| {},
+            ),
+            Some(images) => {
+                let records = &mut tile.strategies;
+                records.start_sample();
+                let value = self.sample(
+                    scene,
+                    *ray,
+                    sampler,
+                    scratch,
+                    &mut tile.splats,
+                    &mut counts,
+                    true,
+                    |e| records.record(images, e, raster),
+                );
+                records.end_sample(value.is_valid_radiance());
+                value
             }
-            self.stats.rays += r.rays;
-            self.stats.invalid_samples += r.invalid;
-            self.film.recycle(r.tile);
+        };
+        tile.invalid += counts.1;
+        (value, counts.0)
+    }
+
+    fn merge_extra(&mut self, film: &mut Film, tile: &mut BdptTile) -> u64 {
+        film.merge_splats(&tile.splats);
+        if let Some(images) = &mut self.strategy_images {
+            images.merge(&tile.strategies);
         }
-        self.stats.passes += 1;
-        self.stats.samples += self.film.width() as u64 * self.film.height() as u64;
+        tile.invalid
     }
 
-    fn image(&self) -> Image {
-        // One light subpath per camera sample.
-        self.film.image_with_light_paths(self.stats.samples)
-    }
-
-    fn stats(&self) -> Stats {
-        self.stats.clone()
+    fn splats(&self) -> bool {
+        true
     }
 
     fn keeps_strategy_images(&self) -> bool {
         self.strategy_images.is_some()
     }
 
-    fn strategy_images(&self) -> Option<Vec<StrategyImage>> {
-        Bdpt::strategy_images(self)
+    fn strategy_images(&self, film: &Film, samples: u64) -> Option<Vec<StrategyImage>> {
+        Some(self.strategy_images.as_ref()?.images(film, samples))
     }
 }

@@ -228,8 +228,10 @@ impl PathSample {
         );
 
         // BSDF sampling (`Diffuse::sample`): the next segment.
+        // The walk's four numbers (`Walk::scatter`): component, direction, roulette.
         let _u_lobe = lanes.streams.next_1d(m);
         let (ux, uy) = lanes.streams.next_2d(m);
+        let u_roulette = lanes.streams.next_1d(m);
         let wi = cosine_hemisphere(ux, uy);
         let pdf = F32x16::select(wi.z.gt(zero), wi.z * inv_pi, zero);
         let sampled = m & !wo.z.le(zero) & !pdf.le(zero);
@@ -254,13 +256,12 @@ impl PathSample {
         // Russian roulette.
         let t = lanes.throughput;
         let max_throughput = max_num(max_num(t.x, t.y), t.z);
-        let dark = c & max_throughput.le(zero);
+        let dark = c & !(max_throughput.gt(zero) & max_throughput.is_finite());
         ends |= dark;
-        let rr_depth = U32x16::splat(self.settings.rr_depth);
+        let rr_depth = U32x16::splat(self.settings.path.rr_depth);
         let roulette = c & !dark & !lanes.depth.lt(rr_depth);
         let q = min_num(max_throughput * lanes.eta * lanes.eta, F32x16::splat(0.95));
-        let u = lanes.streams.next_1d(roulette);
-        let killed = roulette & u.ge(q);
+        let killed = roulette & u_roulette.ge(q);
         ends |= killed;
         let survived = roulette & !killed;
         lanes.throughput = V3::select(survived, t.div_scalar(q), t);

@@ -19,7 +19,7 @@
 //! w = p_a² / (p_a² + p_b²) over the two strategies' solid-angle densities (delta lights and
 //! delta BSDF samples take weight 1: the other strategy cannot produce them).
 
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 use super::Params;
 mod diffuse_lanes;
@@ -30,16 +30,20 @@ mod shadow_queue;
 mod wavefront;
 
 use super::camera_pass::{
-    CameraEstimator, CameraSampleFn, PassContext, PassCounts, render_tiles_one_by_one,
+    CameraEstimator, CameraSampleFn, FinishedTile, PassContext, render_tiles_one_by_one,
 };
-use crate::error::{Error, Result};
-use crate::film::{FilmTile, PixelRect};
+use crate::error::Result;
+use crate::film::PixelRect;
 use crate::geometry::{Ray, SurfaceInteraction};
 use crate::light::LightPoint;
-use crate::material::{Bsdf, TransportMode};
+use crate::material::TransportMode;
+use crate::math::Rgb;
 use crate::math::lanes;
-use crate::math::{Frame, Rgb};
 use crate::path::mis::power_heuristic;
+use crate::path::next_event::{self, LightChoice};
+use crate::path::random_walk::Walk;
+use crate::path::settings::PathSettings;
+use crate::path::vertex::{Vertex, VertexKind};
 use crate::sampler::Sampler;
 use crate::sampler::pixel_samples::CameraSampler;
 use crate::scene::Scene;
@@ -47,15 +51,7 @@ use crate::scene::Scene;
 /// `pt`'s settings (`--set key=value`; defaults from the scene's `<integrator>`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PtSettings {
-    /// Longest path in segments; `None` = unbounded (Mitsuba's −1).
-    pub max_depth: Option<u32>,
-    /// Depth from which Russian roulette may end a path.
-    pub rr_depth: u32,
-    /// Emitters the camera sees are left out, as Mitsuba 3.9's `hide_emitters` does it:
-    /// the emission of the surface a camera ray hits first, and the environment for paths
-    /// that escape having crossed nothing but `null` surfaces. Emitting surfaces seen
-    /// through a `null` surface, anything seen in a mirror, and all light reflected stay.
-    pub hide_emitters: bool,
+    pub path: PathSettings,
     /// Trace sixteen paths at a time in SIMD lanes (`wavefront.rs`; the same image bits as
     /// one at a time, faster where the lanes are AVX-512 registers). The default is on
     /// where they are (`lanes::NATIVE`), off elsewhere.
@@ -63,33 +59,11 @@ pub struct PtSettings {
 }
 
 impl PtSettings {
-    /// Reads `max_depth`, `rr_depth` and `hide_emitters`, defaulting to the scene's
-    /// integrator element.
+    /// Reads the path settings (`max_depth`, `rr_depth`, `hide_emitters`) and `wavefront`.
     pub fn from_params(params: &Params, scene: &Scene) -> Result<PtSettings> {
-        let integrator = &scene.description.integrator;
-        let max_depth: i64 = params.get("max_depth", integrator.max_depth as i64)?;
-        let rr_depth: u32 = params.get("rr_depth", integrator.rr_depth)?;
-        let hide_emitters: bool = params.get("hide_emitters", integrator.hide_emitters)?;
-        let wavefront: bool = params.get("wavefront", lanes::NATIVE)?;
-        // The same bounds as the scene's <integrator> (Mitsuba's).
-        if max_depth < -1 {
-            return Err(Error::usage(format!(
-                "--set max_depth={max_depth}: must be -1 (unbounded) or at least 0"
-            )));
-        }
-        if rr_depth == 0 {
-            return Err(Error::usage("--set rr_depth=0: must be at least 1"));
-        }
-        let max_depth = if max_depth < 0 {
-            None
-        } else {
-            Some(max_depth.min(u32::MAX as i64) as u32)
-        };
         Ok(PtSettings {
-            max_depth,
-            rr_depth,
-            hide_emitters,
-            wavefront,
+            path: PathSettings::from_params(params, scene)?,
+            wavefront: params.get("wavefront", lanes::NATIVE)?,
         })
     }
 }
@@ -138,20 +112,14 @@ pub(crate) struct PreviousVertex {
     pub specular: bool,
 }
 
-/// One camera path between two of its vertices: the ray to trace next and what the path
-/// has gathered so far.
+/// One camera path between two of its vertices: the walk (the ray to trace next, the
+/// throughput, the scatterings so far) and what the path has gathered.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PathState {
-    pub ray: Ray,
+    pub walk: Walk,
     /// Radiance found so far.
     pub result: Rgb,
-    pub throughput: Rgb,
-    /// Product of the relative IORs crossed: Russian roulette divides the η² that
-    /// refraction puts into the throughput back out (Mitsuba 3's rule).
-    pub eta: f32,
     pub prev: PreviousVertex,
-    /// Segments so far minus one: the vertex `ray` reaches ends segment depth + 1.
-    pub depth: u32,
     /// Rays cast so far (closest hits and shadow rays).
     pub rays: u64,
 }
@@ -159,24 +127,22 @@ pub(crate) struct PathState {
 impl PathSample {
     /// The longest path in segments (u32::MAX for unbounded).
     pub(crate) fn max_depth(&self) -> u32 {
-        self.settings.max_depth.unwrap_or(u32::MAX)
+        self.settings.path.max_segments()
     }
 
     /// The state of a path that starts with camera ray `ray`.
     pub(crate) fn start(&self, ray: &Ray) -> PathState {
+        let hide = self.settings.path.hide_emitters;
         PathState {
-            ray: *ray,
+            walk: Walk::new(*ray, Rgb::WHITE),
             result: Rgb::BLACK,
-            throughput: Rgb::WHITE,
-            eta: 1.0,
             prev: PreviousVertex {
-                shows_emitters: !self.settings.hide_emitters,
-                shows_environment: !self.settings.hide_emitters,
+                shows_emitters: !hide,
+                shows_environment: !hide,
                 p: ray.o,
                 bsdf_pdf: 1.0,
                 specular: true,
             },
-            depth: 0,
             rays: 0,
         }
     }
@@ -197,41 +163,24 @@ impl PathSample {
         power_heuristic(prev.bsdf_pdf, pdf_light)
     }
 
-    /// Next-event estimation at `si`: a light chosen by power, a point on it, the shadow
-    /// ray, and the MIS-weighted contribution f · Le · |cos θ| / p (without throughput).
-    /// Returns the contribution and the rays cast.
-    fn sample_light(
-        &self,
-        scene: &Scene,
-        si: &SurfaceInteraction,
-        frame: &Frame,
-        bsdf: &Bsdf,
-        wo: Vec3,
-        sampler: &mut impl Sampler,
-    ) -> (Rgb, u64) {
-        let u_light = sampler.next_1d();
-        let u = sampler.next_2d();
-        let Some((index, pmf, _)) = scene.lights.sample(u_light) else {
+    /// Next-event estimation's contribution at surface vertex `v` from the light point
+    /// `light` (chosen by `next_event::sample_light`): the shadow ray and the MIS-weighted
+    /// f · Le · |cos θ| / p (without throughput). Returns the contribution and the rays cast.
+    fn light_contribution(&self, scene: &Scene, v: &Vertex, light: &LightChoice) -> (Rgb, u64) {
+        let VertexKind::Surface { si, bsdf, frame } = &v.kind else {
             return (Rgb::BLACK, 0);
         };
-        let Some(ls) = scene.lights.get(index).sample_li(si.p, u) else {
-            return (Rgb::BLACK, 0);
-        };
+        let ls = &light.sample;
+        let wo = frame.to_local(v.wo);
         let wi = frame.to_local(ls.wi);
         let f = bsdf.eval(wo, wi, TransportMode::Radiance) * wi.z.abs();
         if f.is_black() {
             return (Rgb::BLACK, 0);
         }
-        let shadow = if ls.dist.is_finite() {
-            // Point and spot lights have no error box and no normal: no offset at their end.
-            si.spawn_ray_to_surface(ls.p, ls.p_error, ls.n)
-        } else {
-            si.spawn_ray(ls.wi)
-        };
-        if scene.geometry.occluded(&shadow) {
+        if scene.geometry.occluded(&next_event::shadow_ray(si, ls)) {
             return (Rgb::BLACK, 1);
         }
-        let pdf_light = pmf * ls.pdf_solid_angle;
+        let pdf_light = light.pmf * ls.pdf_solid_angle;
         let weight = if ls.delta {
             1.0
         } else {
@@ -253,12 +202,12 @@ impl PathSample {
         let Some(si) = hit else {
             if prev.shows_environment {
                 // The ray escaped: lights at infinity.
-                let towards_light = state.ray.d.normalize();
+                let towards_light = state.walk.ray.d.normalize();
                 let point = LightPoint::direction(towards_light);
                 for &light in scene.lights.environment() {
                     let le = scene.lights.get(light).le(&point, -towards_light);
                     let w = self.emission_weight(scene, prev, light, &point);
-                    state.result += state.throughput * le * w;
+                    state.result += state.walk.beta * le * w;
                 }
             }
             return false;
@@ -268,18 +217,21 @@ impl PathSample {
             && prev.shows_emitters
         {
             let point = LightPoint::from(si);
-            let le = scene.lights.get(light).le(&point, -state.ray.d.normalize());
+            let le = scene
+                .lights
+                .get(light)
+                .le(&point, -state.walk.ray.d.normalize());
             if !le.is_black() {
                 let w = self.emission_weight(scene, prev, light, &point);
-                state.result += state.throughput * le * w;
+                state.result += state.walk.beta * le * w;
             }
         }
-        state.depth + 1 < self.max_depth()
+        state.walk.depth + 1 < self.max_depth()
     }
 
     /// Scatters the path at `si`, the closest hit of its ray: next-event estimation (a path
-    /// of depth + 2 segments), the BSDF-sampled next ray and Russian roulette. False when
-    /// the path ends here.
+    /// of depth + 2 segments; its three numbers drawn whatever the BSDF), then the walk's
+    /// BSDF sampling and Russian roulette (`Walk::scatter`). False when the path ends here.
     pub(crate) fn scatter(
         &self,
         scene: &Scene,
@@ -287,61 +239,57 @@ impl PathSample {
         si: &SurfaceInteraction,
         sampler: &mut impl Sampler,
     ) -> bool {
-        let bsdf = &*scene.bsdf_at(si);
-        let frame = si.frame();
-        let wo = frame.to_local(-state.ray.d.normalize());
+        let v = Vertex::surface(scene, *si, -state.walk.ray.d.normalize(), state.walk.beta);
 
         // Next-event estimation.
-        if bsdf.has_non_delta() {
-            let (contribution, shadow_rays) =
-                self.sample_light(scene, si, &frame, bsdf, wo, sampler);
-            state.result += state.throughput * contribution;
+        let light = next_event::sample_light(scene, si.p, sampler);
+        if let Some(light) = light
+            && v.is_connectible()
+        {
+            let (contribution, shadow_rays) = self.light_contribution(scene, &v, &light);
+            state.result += state.walk.beta * contribution;
             state.rays += shadow_rays;
         }
 
-        // BSDF sampling: the next segment.
-        let u_lobe = sampler.next_1d();
-        let u = sampler.next_2d();
-        let Some(bs) = bsdf.sample(wo, u_lobe, u, TransportMode::Radiance) else {
+        // BSDF sampling (the next segment) and Russian roulette.
+        let rr_depth = self.settings.path.rr_depth;
+        let Some(scattered) = state
+            .walk
+            .scatter(&v, TransportMode::Radiance, rr_depth, sampler)
+        else {
             return false;
         };
-        state.throughput *= bs.weight;
-        state.eta *= bs.eta;
         state.prev = PreviousVertex {
             shows_emitters: true,
-            shows_environment: state.prev.shows_environment || !bsdf.is_null(),
+            shows_environment: state.prev.shows_environment || !v.is_null_surface(),
             p: si.p,
-            bsdf_pdf: bs.pdf,
-            specular: bs.delta,
+            bsdf_pdf: scattered.sample.pdf,
+            specular: scattered.sample.delta,
         };
-        state.ray = si.spawn_ray(frame.to_world(bs.wi));
-        state.depth += 1;
-
-        // Russian roulette.
-        let max_throughput = state.throughput.max_component();
-        if max_throughput <= 0.0 {
-            return false;
-        }
-        if state.depth >= self.settings.rr_depth {
-            let q = (max_throughput * state.eta * state.eta).min(0.95);
-            if sampler.next_1d() >= q {
-                return false;
-            }
-            state.throughput /= q;
-        }
         true
     }
 }
 
 impl CameraSampleFn for PathSample {
-    fn radiance(&self, scene: &Scene, ray: &Ray, sampler: &mut CameraSampler) -> (Rgb, u64) {
+    type Scratch<'a> = ();
+    type Extra = ();
+
+    fn radiance(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        _raster: Vec2,
+        sampler: &mut CameraSampler,
+        _scratch: &mut (),
+        _extra: &mut (),
+    ) -> (Rgb, u64) {
         if self.max_depth() == 0 {
             return (Rgb::BLACK, 0);
         }
         let mut state = self.start(ray);
         loop {
             state.rays += 1;
-            let hit = scene.geometry.intersect(&state.ray);
+            let hit = scene.geometry.intersect(&state.walk.ray);
             if !self.arrive(scene, &mut state, hit.as_ref()) {
                 break;
             }
@@ -360,7 +308,7 @@ impl CameraSampleFn for PathSample {
         }
     }
 
-    fn render_tiles(&self, ctx: &PassContext, rects: &[PixelRect]) -> Vec<(FilmTile, PassCounts)> {
+    fn render_tiles(&self, ctx: &PassContext, rects: &[PixelRect]) -> Vec<FinishedTile<()>> {
         if self.settings.wavefront {
             self.render_tiles_in_lanes(ctx, rects)
         } else {

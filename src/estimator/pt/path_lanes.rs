@@ -9,6 +9,7 @@ use crate::geometry::Ray;
 use crate::geometry::packet::RayLanes;
 use crate::math::Rgb;
 use crate::math::lanes::{F32x16, LANES, Mask16, U32x16, V3};
+use crate::path::random_walk::Walk;
 use crate::sampler::lane_streams::LaneStreams;
 
 /// Lane `i` of `v`.
@@ -121,14 +122,17 @@ impl PathLanes {
             Rgb::new(c.x, c.y, c.z)
         };
         PathState {
-            ray: Ray {
-                o: lane3(&self.origin, i),
-                d: lane3(&self.direction, i),
-                t_max: lane(self.t_max, i),
+            walk: Walk {
+                ray: Ray {
+                    o: lane3(&self.origin, i),
+                    d: lane3(&self.direction, i),
+                    t_max: lane(self.t_max, i),
+                },
+                beta: rgb(&self.throughput),
+                eta: lane(self.eta, i),
+                depth: self.depth.to_array()[i],
             },
             result: Rgb::BLACK,
-            throughput: rgb(&self.throughput),
-            eta: lane(self.eta, i),
             prev: PreviousVertex {
                 shows_emitters: self.shows_emitters.get(i),
                 shows_environment: self.shows_environment.get(i),
@@ -136,7 +140,6 @@ impl PathLanes {
                 bsdf_pdf: lane(self.prev_pdf, i),
                 specular: self.prev_specular.get(i),
             },
-            depth: self.depth.to_array()[i],
             rays: self.rays.to_array()[i] as u64,
         }
     }
@@ -145,18 +148,19 @@ impl PathLanes {
     /// sample keeps).
     pub fn put(&mut self, i: usize, state: &PathState) {
         let rgb = |c: Rgb| Vec3::new(c.r(), c.g(), c.b());
-        put3(&mut self.origin, i, state.ray.o);
-        put3(&mut self.direction, i, state.ray.d);
-        self.t_max = with_lane(self.t_max, i, state.ray.t_max);
-        put3(&mut self.throughput, i, rgb(state.throughput));
-        self.eta = with_lane(self.eta, i, state.eta);
+        let walk = &state.walk;
+        put3(&mut self.origin, i, walk.ray.o);
+        put3(&mut self.direction, i, walk.ray.d);
+        self.t_max = with_lane(self.t_max, i, walk.ray.t_max);
+        put3(&mut self.throughput, i, rgb(walk.beta));
+        self.eta = with_lane(self.eta, i, walk.eta);
         self.shows_emitters.set(i, state.prev.shows_emitters);
         self.shows_environment.set(i, state.prev.shows_environment);
         put3(&mut self.prev_p, i, state.prev.p);
         self.prev_pdf = with_lane(self.prev_pdf, i, state.prev.bsdf_pdf);
         self.prev_specular.set(i, state.prev.specular);
         let m = Mask16(1 << i);
-        self.depth = U32x16::select(m, U32x16::splat(state.depth), self.depth);
+        self.depth = U32x16::select(m, U32x16::splat(walk.depth), self.depth);
         // A camera path casts at most a few thousand rays (max_depth bounds it, Russian
         // roulette ends unbounded ones): u32 holds any count a path reaches.
         let rays = state.rays.min(u32::MAX as u64) as u32;

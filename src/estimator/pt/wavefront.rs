@@ -24,8 +24,8 @@ use super::lane_scene::NO_LIGHT;
 use super::path_lanes::PathLanes;
 use super::shadow_queue::ShadowQueue;
 use crate::camera::raster_in_pixel_lanes;
-use crate::estimator::camera_pass::{PassContext, PassCounts, start_camera_sample};
-use crate::film::{FilmTile, PixelRect};
+use crate::estimator::camera_pass::{FinishedTile, PassContext, PassCounts, start_camera_sample};
+use crate::film::PixelRect;
 use crate::geometry::packet::RayLanes;
 use crate::math::Rgb;
 use crate::math::lanes::{F32x16, LANES, Mask16, U32x16};
@@ -55,7 +55,7 @@ impl PathSample {
         &self,
         ctx: &PassContext,
         rects: &[PixelRect],
-    ) -> Vec<(FilmTile, PassCounts)> {
+    ) -> Vec<FinishedTile<()>> {
         // Each worker thread keeps its queue from batch to batch (no allocation per batch).
         thread_local! {
             static QUEUE: RefCell<Vec<QueuedSample>> = const { RefCell::new(Vec::new()) };
@@ -94,7 +94,11 @@ impl PathSample {
                         for q in samples.by_ref().take(n) {
                             counts.add_sample(&mut tile, q.raster, q.value, q.rays);
                         }
-                        (tile, counts)
+                        FinishedTile {
+                            tile,
+                            counts,
+                            extra: (),
+                        }
                     })
                     .collect()
             })
@@ -184,7 +188,7 @@ impl PathSample {
             (F32x16::splat(0.0), F32x16::splat(0.0))
         };
         let rays = camera.sample_ray_lanes(rx, ry, lens);
-        lanes.start(m, &rays, self.settings.hide_emitters);
+        lanes.start(m, &rays, self.settings.path.hide_emitters);
         let (rx, ry) = (rx.to_array(), ry.to_array());
         for lane in m.lanes() {
             queue[lanes.sample[lane] as usize].raster = Vec2::new(rx[lane], ry[lane]);

@@ -1,4 +1,4 @@
-//! The Mitsuba 3 XML reader (DESIGN.md §4).
+//! The Mitsuba 3 XML reader (docs/DESIGN.md §4).
 //!
 //! Two passes. `xml` reads the scene file and everything it includes into one element tree
 //! (defaults substituted, ids indexed, structure checked), so references may point forward or
