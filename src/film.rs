@@ -283,6 +283,11 @@ impl SplatList {
         self.entries.push((raster, value));
     }
 
+    /// The splats in the order they were recorded.
+    pub fn entries(&self) -> &[(Vec2, Rgb)] {
+        &self.entries
+    }
+
     pub fn len(&self) -> usize {
         self.entries.len()
     }

@@ -240,6 +240,12 @@ pub fn start_camera_sample(
     pass_index: u32,
 ) -> (Vec2, Ray) {
     sampler.start_pixel_sample((x, y), pass_index as u64);
+    camera_ray(camera, (x, y), sampler)
+}
+
+/// The camera sample's first draws, from the camera stream: the raster position within
+/// pixel `pixel`, then (only for a lens) the lens point; the raster position and the ray.
+pub fn camera_ray(camera: &Camera, (x, y): (u32, u32), sampler: &mut impl Sampler) -> (Vec2, Ray) {
     sampler.start_stream(Stream::Camera);
     let raster = raster_in_pixel(x, y, sampler.next_2d());
     let ray = if camera.has_lens() {

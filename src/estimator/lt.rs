@@ -89,7 +89,7 @@ impl LightTracer {
     fn trace(
         &self,
         scene: &Scene,
-        sampler: &mut IndependentSampler,
+        sampler: &mut impl Sampler,
         splats: &mut SplatList,
         counts: &mut BlockCounts,
     ) {

@@ -151,6 +151,18 @@ pub struct Scratch<'a> {
     densities: Vec<PathDensity>,
 }
 
+impl<'a> Scratch<'a> {
+    /// The last camera sample's camera subpath.
+    pub fn camera_path(&self) -> &[Vertex<'a>] {
+        &self.camera_path
+    }
+
+    /// The last camera sample's light subpath.
+    pub fn light_path(&self) -> &[Vertex<'a>] {
+        &self.light_path
+    }
+}
+
 impl BdptSample {
     /// The most vertices a walk adds to a subpath: `max_depth` on the camera side (the
     /// camera point and those vertices make paths of at most `max_depth` segments), one
@@ -168,11 +180,11 @@ impl BdptSample {
     /// value; splats go to `splats`. `observe` sees every strategy that contributes; with
     /// `every_strategy`, also those whose weight is 0 (their visibility is tested anyway).
     #[allow(clippy::too_many_arguments)]
-    fn sample<'a>(
+    pub fn trace<'a>(
         &self,
         scene: &'a Scene,
         ray: Ray,
-        sampler: &mut CameraSampler,
+        sampler: &mut impl Sampler,
         scratch: &mut Scratch<'a>,
         splats: &mut SplatList,
         counts: &mut (u64, u64),
@@ -279,7 +291,7 @@ impl Bdpt {
         let (_, ray) = start_camera_sample(&scene.camera, &mut sampler, x, y, index);
         let mut scratch = Scratch::default();
         let mut splats = SplatList::new();
-        self.sample_fn().sample(
+        self.sample_fn().trace(
             scene,
             ray,
             &mut sampler,
@@ -307,7 +319,7 @@ impl CameraSampleFn for BdptSample {
     ) -> (Rgb, u64) {
         let mut counts = (0u64, 0u64);
         let value = match &self.strategy_images {
-            None => self.sample(
+            None => self.trace(
                 scene,
                 *ray,
                 sampler,
@@ -320,7 +332,7 @@ impl CameraSampleFn for BdptSample {
             Some(images) => {
                 let records = &mut tile.strategies;
                 records.start_sample();
-                let value = self.sample(
+                let value = self.trace(
                     scene,
                     *ray,
                     sampler,

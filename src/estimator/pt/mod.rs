@@ -268,21 +268,9 @@ impl PathSample {
         };
         true
     }
-}
 
-impl CameraSampleFn for PathSample {
-    type Scratch<'a> = ();
-    type Extra = ();
-
-    fn radiance(
-        &self,
-        scene: &Scene,
-        ray: &Ray,
-        _raster: Vec2,
-        sampler: &mut CameraSampler,
-        _scratch: &mut (),
-        _extra: &mut (),
-    ) -> (Rgb, u64) {
+    /// One camera path along `ray`, one vertex at a time: its radiance and the rays cast.
+    pub fn trace(&self, scene: &Scene, ray: &Ray, sampler: &mut impl Sampler) -> (Rgb, u64) {
         if self.max_depth() == 0 {
             return (Rgb::BLACK, 0);
         }
@@ -298,6 +286,23 @@ impl CameraSampleFn for PathSample {
             }
         }
         (state.result, state.rays)
+    }
+}
+
+impl CameraSampleFn for PathSample {
+    type Scratch<'a> = ();
+    type Extra = ();
+
+    fn radiance(
+        &self,
+        scene: &Scene,
+        ray: &Ray,
+        _raster: Vec2,
+        sampler: &mut CameraSampler,
+        _scratch: &mut (),
+        _extra: &mut (),
+    ) -> (Rgb, u64) {
+        self.trace(scene, ray, sampler)
     }
 
     fn tiles_per_task(&self) -> usize {
