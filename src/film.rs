@@ -509,25 +509,10 @@ impl Film {
         if !(x >= 0.0 && x <= self.width as f64 && y >= 0.0 && y <= self.height as f64) {
             return;
         }
-        let Some((x0, x1)) = clip(self.filter.footprint(x), 0, self.width as i64) else {
-            return;
-        };
-        let Some((y0, y1)) = clip(self.filter.footprint(y), 0, self.height as i64) else {
-            return;
-        };
-        weights_1d(&self.filter, x, x0, x1, &mut self.scratch_x);
-        weights_1d(&self.filter, y, y0, y1, &mut self.scratch_y);
-        let v = value.0.map(f64::from);
-        for (j, &wy) in (y0..=y1).zip(&self.scratch_y) {
-            let row = j as usize * self.width as usize;
-            for (i, &wx) in (x0..=x1).zip(&self.scratch_x) {
-                let w = wx * wy;
-                let s = &mut self.splats[row + i as usize];
-                for k in 0..3 {
-                    s[k] += w * v[k];
-                }
-            }
-        }
+        self.add_filtered(raster, value, |film, p| {
+            let [r, g, b] = &mut film.splats[p];
+            [r, g, b]
+        });
     }
 
     /// Adds `value` at raster position `raster` through the filter as a camera sample's, but
@@ -539,6 +524,20 @@ impl Film {
             self.invalid_samples += 1;
             return;
         }
+        self.add_filtered(raster, value, |film, p| {
+            let [r, g, b, _] = &mut film.sums[p];
+            [r, g, b]
+        });
+    }
+
+    /// Adds w·`value` to the three sums `target(film, pixel)` gives, for every pixel the
+    /// filter reaches from `raster` (weight w), clipped to the image.
+    fn add_filtered(
+        &mut self,
+        raster: Vec2,
+        value: Rgb,
+        target: impl for<'f> Fn(&'f mut Film, usize) -> [&'f mut f64; 3],
+    ) {
         let (x, y) = (raster.x as f64, raster.y as f64);
         let Some((x0, x1)) = clip(self.filter.footprint(x), 0, self.width as i64) else {
             return;
@@ -549,13 +548,13 @@ impl Film {
         weights_1d(&self.filter, x, x0, x1, &mut self.scratch_x);
         weights_1d(&self.filter, y, y0, y1, &mut self.scratch_y);
         let v = value.0.map(f64::from);
-        for (j, &wy) in (y0..=y1).zip(&self.scratch_y) {
+        for j in y0..=y1 {
+            let wy = self.scratch_y[(j - y0) as usize];
             let row = j as usize * self.width as usize;
-            for (i, &wx) in (x0..=x1).zip(&self.scratch_x) {
-                let w = wx * wy;
-                let s = &mut self.sums[row + i as usize];
-                for k in 0..3 {
-                    s[k] += w * v[k];
+            for i in x0..=x1 {
+                let w = self.scratch_x[(i - x0) as usize] * wy;
+                for (s, v) in target(self, row + i as usize).into_iter().zip(v) {
+                    *s += w * v;
                 }
             }
         }

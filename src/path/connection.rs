@@ -65,17 +65,7 @@ pub fn connect<'a>(
         return light_vertex_to_camera(scene, light_path, start, s, hide_emitters, sampler);
     }
     let pt = &camera_path[t - 1];
-    if !pt.is_connectible() {
-        return None;
-    }
-    let VertexKind::Surface {
-        si: si_pt,
-        bsdf: bsdf_pt,
-        frame: frame_pt,
-    } = &pt.kind
-    else {
-        return None;
-    };
+    let (si_pt, bsdf_pt, frame_pt) = pt.connectible_surface()?;
     if s == 1 {
         // Next-event estimation from z(t−1).
         let LightChoice {
@@ -107,17 +97,7 @@ pub fn connect<'a>(
         });
     }
     let qs = &light_path[s - 1];
-    if !qs.is_connectible() {
-        return None;
-    }
-    let VertexKind::Surface {
-        si: si_qs,
-        bsdf: bsdf_qs,
-        frame: frame_qs,
-    } = &qs.kind
-    else {
-        return None;
-    };
+    let (si_qs, bsdf_qs, frame_qs) = qs.connectible_surface()?;
     let d = pt.p - qs.p;
     let dist2 = d.length_squared();
     if dist2.is_nan() || dist2 <= 0.0 {

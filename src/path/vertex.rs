@@ -167,6 +167,15 @@ impl<'a> Vertex<'a> {
         matches!(&self.kind, VertexKind::Surface { bsdf, .. } if bsdf.is_null())
     }
 
+    /// A surface vertex a connection can end at: its interaction, BSDF and shading frame.
+    #[inline]
+    pub fn connectible_surface(&self) -> Option<(&SurfaceInteraction, &Bsdf, &Frame)> {
+        match &self.kind {
+            VertexKind::Surface { si, bsdf, frame } if self.connectible => Some((si, bsdf, frame)),
+            _ => None,
+        }
+    }
+
     /// The surface interaction of a surface vertex.
     pub fn si(&self) -> Option<&SurfaceInteraction> {
         match &self.kind {
