@@ -215,10 +215,16 @@ fn run_render(args: RenderArgs) -> Result<bool> {
         .clone()
         .unwrap_or_else(|| default_output(&args.common.scene));
     // Refused now rather than after the render: its result would be lost.
-    let preview = io::outputs::check_outputs(&output, &["png"])?.remove(0);
+    let mut sidecars = io::outputs::check_outputs(&output, &["png", "json"])?;
+    // The JSON is written only by estimators with diagnostics (`pssmlt`, `mmlt`).
+    let diagnostics_path = sidecars.pop().unwrap();
+    let preview = sidecars.remove(0);
     let scene_params = parse_defines(&args.common.define)?;
     let description = mitsuba::load_file_with(&args.common.scene, &scene_params)?;
-    io::outputs::check_not_inputs([output.as_path(), &preview], &description.files_read)?;
+    io::outputs::check_not_inputs(
+        [output.as_path(), &preview, &diagnostics_path],
+        &description.files_read,
+    )?;
     // Degenerate triangles are among these, once per mesh with its line.
     for warning in &description.warnings {
         eprintln!("warning: {warning}");
@@ -272,6 +278,15 @@ fn run_render(args: RenderArgs) -> Result<bool> {
 
     io::exr::write_exr(&output, &result.image)?;
     io::png::write_png_preview(&preview, &result.image)?;
+    if let Some(diagnostics) = estimator.diagnostics() {
+        let text = serde_json::to_string_pretty(&diagnostics).unwrap_or_default() + "\n";
+        io::atomic::write_file_atomically(&diagnostics_path, text.as_bytes())?;
+        eprintln!(
+            "{}: chain diagnostics -> {}",
+            args.common.estimator,
+            diagnostics_path.display()
+        );
+    }
     if let (Some(folder), Some(images)) = (&strategy_folder, estimator.strategy_images()) {
         io::strategy_images::write(folder, &result.image, &images, true)?;
         eprintln!(

@@ -248,12 +248,33 @@ pub fn start_camera_sample(
 pub fn camera_ray(camera: &Camera, (x, y): (u32, u32), sampler: &mut impl Sampler) -> (Vec2, Ray) {
     sampler.start_stream(Stream::Camera);
     let raster = raster_in_pixel(x, y, sampler.next_2d());
-    let ray = if camera.has_lens() {
+    (raster, ray_from_raster(camera, raster, sampler))
+}
+
+/// A camera sample anywhere on a `width` × `height` film: the camera stream's first 2D draw
+/// spans the whole image (so that a Metropolis sampler moves the sample across pixels),
+/// then (only for a lens) the lens point; the raster position and the ray.
+pub fn camera_ray_in_image(
+    camera: &Camera,
+    (width, height): (u32, u32),
+    sampler: &mut impl Sampler,
+) -> (Vec2, Ray) {
+    sampler.start_stream(Stream::Camera);
+    let u = sampler.next_2d();
+    let (x, y) = (u.x * width as f32, u.y * height as f32);
+    // The pixel the position falls in, then the offset in it (guarded against rounding up).
+    let (px, py) = ((x as u32).min(width - 1), (y as u32).min(height - 1));
+    let raster = raster_in_pixel(px, py, Vec2::new(x - px as f32, y - py as f32));
+    (raster, ray_from_raster(camera, raster, sampler))
+}
+
+/// The camera ray through `raster`, drawing the lens point for a thin lens.
+fn ray_from_raster(camera: &Camera, raster: Vec2, sampler: &mut impl Sampler) -> Ray {
+    if camera.has_lens() {
         camera.sample_ray(raster, sampler.next_2d())
     } else {
         camera.generate_ray(raster)
-    };
-    (raster, ray)
+    }
 }
 
 /// An estimator that takes one camera sample per pixel and pass, computed by `S`

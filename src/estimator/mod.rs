@@ -9,6 +9,7 @@ pub mod bdpt;
 pub mod camera_pass;
 pub mod eyelight;
 pub mod lt;
+pub mod mlt;
 pub mod params;
 pub mod pt;
 
@@ -57,10 +58,15 @@ pub trait Estimator: Send {
     fn strategy_images(&self) -> Option<Vec<bdpt::StrategyImage>> {
         None
     }
+    /// What the estimator reports about itself beyond `stats`, as JSON written beside its
+    /// images (the Metropolis estimators' chain diagnostics); None for most.
+    fn diagnostics(&self) -> Option<serde_json::Value> {
+        None
+    }
 }
 
 /// Names of the estimators this build knows, for `--help` and error messages.
-pub const ESTIMATOR_NAMES: &[&str] = &["pt", "lt", "bdpt", "eyelight"];
+pub const ESTIMATOR_NAMES: &[&str] = &["pt", "lt", "bdpt", "pssmlt", "mmlt", "eyelight"];
 
 /// Fails, listing the known names, unless `name` is one of `ESTIMATOR_NAMES`: for commands
 /// to check before they load a scene.
@@ -99,6 +105,8 @@ pub fn create(name: &str, params: &Params, scene: &Scene, seed: u64) -> Result<B
             bdpt::new(scene, seed, bdpt::BdptSettings::from_params(params, scene)?)?
                 .with_pixel_samples(pixel_samples(params, scene, seed)?),
         ),
+        "pssmlt" => mlt::pssmlt(params, scene, seed)?,
+        "mmlt" => Box::new(mlt::mmlt(params, scene, seed)?),
         _ => return Err(unknown_estimator(name)),
     };
     params.check_all_used(name)?;

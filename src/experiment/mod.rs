@@ -10,6 +10,7 @@
 //! * `report`: merges whatever cells are present into the summary and the README;
 //! * `strategies`: the optional `[strategies]` table, which bdpt strategy carries what.
 
+pub mod chain_diagnostics;
 pub mod metrics;
 pub mod plot;
 pub mod reference;

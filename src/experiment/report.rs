@@ -543,6 +543,9 @@ fn readme(
     let _ = writeln!(md, "![relMSE against passes](convergence-passes.png)\n");
     let _ = writeln!(md, "![bias² and variance against time](bias.png)\n");
     let _ = writeln!(md, "![final images and relative-error maps](contact.png)\n");
+    if let Some(section) = super::chain_diagnostics::readme_section(experiment, results) {
+        md.push_str(&section);
+    }
     if let Some(section) = super::strategies::readme_section(experiment, results) {
         md.push_str(&section);
     }

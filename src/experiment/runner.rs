@@ -243,6 +243,11 @@ impl ResultsDir {
             .join(format!("{}-run{run}.csv", file_label(label)))
     }
 
+    /// The estimator's own diagnostics of one run (the Metropolis estimators' chains), JSON.
+    pub fn cell_diagnostics(&self, label: &str, run: u32) -> PathBuf {
+        self.cell_csv(label, run).with_extension("json")
+    }
+
     pub fn checkpoint_image(&self, label: &str, run: u32, checkpoint: u32) -> PathBuf {
         self.dir
             .join("checkpoints")
@@ -431,6 +436,7 @@ pub fn clear_cell(experiment: &Experiment, results: &ResultsDir, e: usize, r: u3
     let final_image = results.final_image(label, r);
     let mut files = vec![
         results.cell_csv(label, r),
+        results.cell_diagnostics(label, r),
         final_image.with_extension("png"),
         final_image,
     ];
@@ -584,6 +590,11 @@ pub fn run_cell(
     }
     let final_path = results.final_image(&entry.label, run);
     write_exr(&final_path, &image)?;
+    if let Some(diagnostics) = est.diagnostics() {
+        let path = results.cell_diagnostics(&entry.label, run);
+        let text = serde_json::to_string_pretty(&diagnostics).unwrap_or_default();
+        std::fs::write(&path, text + "\n").map_err(|e| Error::io(&path, e))?;
+    }
     if run == 0 {
         write_png_preview(&final_path.with_extension("png"), &image)?;
     }

@@ -11,6 +11,7 @@ pub mod pattern;
 pub mod permutation;
 pub mod pixel_samples;
 pub mod poisson;
+pub mod primary_sample;
 pub mod regular;
 pub mod sobol;
 pub mod stratified;

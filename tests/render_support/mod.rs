@@ -283,7 +283,12 @@ pub fn shipped_scene(file: &str, res: u32) -> Scene {
 /// Per run, the mean of each `BLOCK`×`BLOCK` block of pixels, per channel:
 /// `[block][channel]`.
 pub fn block_means(image: &Image) -> Vec<[f64; 3]> {
-    const BLOCK: u32 = 4;
+    block_means_of(image, 4)
+}
+
+/// `block_means` with blocks of `BLOCK` × `BLOCK` pixels.
+#[allow(non_snake_case)]
+pub fn block_means_of(image: &Image, BLOCK: u32) -> Vec<[f64; 3]> {
     let mut out = Vec::new();
     for by in 0..image.height / BLOCK {
         for bx in 0..image.width / BLOCK {
@@ -305,9 +310,14 @@ pub fn block_means(image: &Image) -> Vec<[f64; 3]> {
 /// Welch's t-test of every block and channel between the runs of two estimators: the
 /// smallest two-sided p-value and how many tests there were.
 pub fn smallest_block_p_value(a: &[Image], b: &[Image]) -> (f64, usize, String) {
+    smallest_block_p_value_of(a, b, 4)
+}
+
+/// `smallest_block_p_value` over blocks of `block` × `block` pixels.
+pub fn smallest_block_p_value_of(a: &[Image], b: &[Image], block: u32) -> (f64, usize, String) {
     let (ma, mb): (Vec<_>, Vec<_>) = (
-        a.iter().map(block_means).collect(),
-        b.iter().map(block_means).collect(),
+        a.iter().map(|im| block_means_of(im, block)).collect(),
+        b.iter().map(|im| block_means_of(im, block)).collect(),
     );
     let mut smallest = (1.0f64, String::new());
     let blocks = ma[0].len();
@@ -341,7 +351,12 @@ pub fn smallest_block_p_value(a: &[Image], b: &[Image]) -> (f64, usize, String) 
 /// Asserts that no 4×4 block and channel differs between the runs `a` and `b` of two
 /// estimators at family-wise significance 10⁻³ (Šidák over all blocks and channels).
 pub fn assert_blocks_agree(what: &str, a: &[Image], b: &[Image]) {
-    let (p, tests, worst) = smallest_block_p_value(a, b);
+    assert_blocks_agree_of(what, a, b, 4);
+}
+
+/// `assert_blocks_agree` over blocks of `block` × `block` pixels.
+pub fn assert_blocks_agree_of(what: &str, a: &[Image], b: &[Image], block: u32) {
+    let (p, tests, worst) = smallest_block_p_value_of(a, b, block);
     let per_test = 1.0 - (1.0f64 - 1e-3).powf(1.0 / tests as f64);
     eprintln!("{what}: smallest p {p:.2e} over {tests} tests (threshold {per_test:.2e}); {worst}");
     assert!(

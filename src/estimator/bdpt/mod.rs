@@ -53,15 +53,7 @@ pub struct BdptSettings {
 impl BdptSettings {
     pub fn from_params(params: &Params, scene: &Scene) -> Result<BdptSettings> {
         let path = PathSettings::from_params(params, scene)?;
-        let mis = match params.get("mis", "balance".to_string())?.as_str() {
-            "balance" => Heuristic::Balance,
-            "power" => Heuristic::Power,
-            other => {
-                return Err(Error::usage(format!(
-                    "--set mis={other}: expected balance or power"
-                )));
-            }
-        };
+        let mis = mis_from_params(params)?;
         let strategies = params.get("strategies", false)?;
         let strategies_max_depth: u32 = params.get("strategies_max_depth", 8)?;
         if !(1..=MAX_STRATEGIES_DEPTH).contains(&strategies_max_depth) {
@@ -76,6 +68,17 @@ impl BdptSettings {
             strategies,
             strategies_max_depth,
         })
+    }
+}
+
+/// The `mis` parameter: `balance` (the default) or `power`.
+pub fn mis_from_params(params: &Params) -> Result<Heuristic> {
+    match params.get("mis", "balance".to_string())?.as_str() {
+        "balance" => Ok(Heuristic::Balance),
+        "power" => Ok(Heuristic::Power),
+        other => Err(Error::usage(format!(
+            "--set mis={other}: expected balance or power"
+        ))),
     }
 }
 
@@ -164,6 +167,22 @@ impl<'a> Scratch<'a> {
 }
 
 impl BdptSample {
+    /// One camera sample's strategies under `settings`, without strategy images (for
+    /// estimators that evaluate samples through their own sampler: `pssmlt base=bdpt`).
+    pub fn without_images(settings: BdptSettings) -> BdptSample {
+        BdptSample {
+            settings: BdptSettings {
+                strategies: false,
+                ..settings
+            },
+            strategy_images: None,
+        }
+    }
+
+    pub fn settings(&self) -> &BdptSettings {
+        &self.settings
+    }
+
     /// The most vertices a walk adds to a subpath: `max_depth` on the camera side (the
     /// camera point and those vertices make paths of at most `max_depth` segments), one
     /// fewer on the light side, whose light vertex counts.

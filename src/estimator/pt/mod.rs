@@ -94,6 +94,20 @@ pub struct PathSample {
     lane_scene: Option<lane_scene::LaneScene>,
 }
 
+impl PathSample {
+    /// `pt`'s camera path one vertex at a time (no lanes), for estimators that evaluate
+    /// one path at a time through their own sampler (`pssmlt base=pt`).
+    pub fn one_at_a_time(path: PathSettings) -> PathSample {
+        PathSample {
+            settings: PtSettings {
+                path,
+                wavefront: false,
+            },
+            lane_scene: None,
+        }
+    }
+}
+
 /// What the next vertex needs to weight emission found by the BSDF-sampled ray.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct PreviousVertex {

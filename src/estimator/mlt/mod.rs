@@ -1,0 +1,373 @@
+//! Metropolis light transport in primary sample space: `pssmlt` (Kelemen et al. 2002, over
+//! `pt` or `bdpt`) and `mmlt` (Hachisuka et al. 2014, multiplexed over `bdpt`'s
+//! strategies).
+//!
+//! * A path function (`target`) maps a point of primary sample space to contributions on
+//!   the film; the estimators' own sample code reads the point through the sampler
+//!   contract from a `PrimarySampleSampler`, which the chains mutate.
+//! * The bootstrap: `bootstrap` independent points (per stratum: `mmlt`'s path lengths)
+//!   estimate the normalisation b = ∫ I (the mean importance), and chains start at points
+//!   drawn from them in proportion to I (systematic resampling): the chains start in their
+//!   stationary distribution (no start-up bias up to the bootstrap's finite size).
+//! * `chains` chains, each with its own mutation stream keyed by (seed, chain): their
+//!   number and their streams do not depend on the thread count. A pass is one mutation
+//!   per pixel, spread evenly over the chains; each chain's splats of each pass merge in
+//!   (pass, chain) order, so images are bit-identical for any `--threads` and for passes
+//!   taken one at a time or in chunks.
+//! * Image = b × (expected-value splats) / mutations per pixel (`chain`).
+//! * `diagnostics` (JSON beside every image): acceptance, b and its standard error, chains
+//!   that never moved, the integrated autocorrelation time of the chains' importance and
+//!   the effective sample size, mutations per second.
+
+pub mod autocorrelation;
+pub mod chain;
+pub mod diagnostics;
+pub mod multiplexed;
+pub mod settings;
+pub mod target;
+
+use std::time::Instant;
+
+use rayon::prelude::*;
+
+use super::bdpt::{BdptSample, BdptSettings, mis_from_params};
+use super::pt::PathSample;
+use super::{Estimator, Params, Stats};
+use crate::error::{Error, Result};
+use crate::film::{Film, SplatList};
+use crate::image::Image;
+use crate::path::settings::PathSettings;
+use crate::sampler::independent::{hash_words, to_unit_f32};
+use crate::sampler::primary_sample::PrimarySampleSampler;
+use crate::scene::Scene;
+use chain::{Chain, ChainCounts};
+use diagnostics::{Bootstrap, Diagnostics};
+use multiplexed::MultiplexedTarget;
+use settings::ChainSettings;
+use target::{BdptTarget, Contributions, PathTarget, PtTarget};
+
+/// Keys that keep the bootstrap's, the chains' and the selection's streams apart.
+const BOOTSTRAP_KEY: u64 = 0xB007;
+const CHAIN_KEY: u64 = 0xC4A1;
+const SELECT_KEY: u64 = 0x5E1E;
+
+/// A Metropolis estimator over path function `T`.
+pub struct Metropolis<T: PathTarget> {
+    name: &'static str,
+    /// `pssmlt`'s base estimator (for the diagnostics).
+    base: Option<&'static str>,
+    settings: ChainSettings,
+    target: T,
+    seed: u64,
+    film: Film,
+    chains: Vec<Chain>,
+    /// What the bootstrap found (None before the first pass).
+    bootstrap: Option<Bootstrap>,
+    stats: Stats,
+    /// Seconds spent in passes (bootstrap included).
+    seconds: f64,
+    bootstrap_seconds: f64,
+}
+
+/// `pssmlt` with `base=pt`.
+pub type PssmltPt = Metropolis<PtTarget>;
+/// `pssmlt` with `base=bdpt`.
+pub type PssmltBdpt = Metropolis<BdptTarget>;
+/// `mmlt`.
+pub type Mmlt = Metropolis<MultiplexedTarget>;
+
+/// Makes `pssmlt` (`base=bdpt` by default, or `pt`) for `scene`.
+pub fn pssmlt(params: &Params, scene: &Scene, seed: u64) -> Result<Box<dyn Estimator>> {
+    let settings = ChainSettings::from_params(params, true)?;
+    let path = PathSettings::from_params(params, scene)?;
+    check_lights(scene, "pssmlt")?;
+    match params.get("base", "bdpt".to_string())?.as_str() {
+        "pt" => {
+            let target = PtTarget {
+                sample: PathSample::one_at_a_time(path),
+            };
+            Ok(Box::new(Metropolis::new(
+                "pssmlt",
+                Some("pt"),
+                scene,
+                seed,
+                settings,
+                target,
+            )?))
+        }
+        "bdpt" => {
+            let bdpt = BdptSettings {
+                path,
+                mis: mis_from_params(params)?,
+                strategies: false,
+                strategies_max_depth: 1,
+            };
+            let target = BdptTarget {
+                sample: BdptSample::without_images(bdpt),
+            };
+            Ok(Box::new(Metropolis::new(
+                "pssmlt",
+                Some("bdpt"),
+                scene,
+                seed,
+                settings,
+                target,
+            )?))
+        }
+        other => Err(Error::usage(format!(
+            "--set base={other}: expected pt or bdpt"
+        ))),
+    }
+}
+
+/// Makes `mmlt` for `scene`; `max_depth` must be finite.
+pub fn mmlt(params: &Params, scene: &Scene, seed: u64) -> Result<Mmlt> {
+    let settings = ChainSettings::from_params(params, false)?;
+    let path = PathSettings::from_params(params, scene)?;
+    check_lights(scene, "mmlt")?;
+    let Some(max_depth) = path.max_depth else {
+        return Err(Error::usage(
+            "max_depth=-1 (unbounded): mmlt picks one path length per state, so the \
+             lengths must be enumerable; pass --set max_depth=N (N ≥ 1) or set the scene's \
+             integrator max_depth",
+        ));
+    };
+    let target = MultiplexedTarget::new(path, mis_from_params(params)?, max_depth);
+    Metropolis::new("mmlt", None, scene, seed, settings, target)
+}
+
+/// A scene without a light has nothing to explore: an error naming the scene.
+fn check_lights(scene: &Scene, name: &str) -> Result<()> {
+    if scene.lights.is_empty() {
+        return Err(Error::usage(format!(
+            "{}: the scene has no light, so {name} has no path to start a chain from",
+            scene.description.source.display()
+        )));
+    }
+    Ok(())
+}
+
+/// Mutations chain `k` of `chains` takes in one pass of `pixels` mutations.
+fn share(pixels: u64, chains: u64, k: u64) -> u64 {
+    pixels / chains + u64::from(k < pixels % chains)
+}
+
+impl<T: PathTarget> Metropolis<T> {
+    pub fn new(
+        name: &'static str,
+        base: Option<&'static str>,
+        scene: &Scene,
+        seed: u64,
+        settings: ChainSettings,
+        target: T,
+    ) -> Result<Self> {
+        let window = scene.description.sensor.film.window();
+        let film = Film::new(
+            window.width,
+            window.height,
+            scene.description.sensor.film.filter,
+        )?;
+        Ok(Metropolis {
+            name,
+            base,
+            settings,
+            target,
+            seed,
+            film,
+            chains: Vec::new(),
+            bootstrap: None,
+            stats: Stats::default(),
+            seconds: 0.0,
+            bootstrap_seconds: 0.0,
+        })
+    }
+
+    /// The path function the chains explore.
+    pub fn target(&self) -> &T {
+        &self.target
+    }
+
+    /// What the bootstrap found (after the first pass).
+    pub fn bootstrap(&self) -> Option<&Bootstrap> {
+        self.bootstrap.as_ref()
+    }
+
+    /// The chains (their counts and recorded importances).
+    pub fn chains(&self) -> &[Chain] {
+        &self.chains
+    }
+
+    fn sampler(&self, key: &[u64]) -> PrimarySampleSampler {
+        PrimarySampleSampler::new(key, self.settings.large_step, self.settings.mutation)
+    }
+
+    /// The bootstrap, then the chains' first states.
+    fn start(&mut self, scene: &Scene) {
+        let strata = self.target.strata();
+        let n = self.settings.bootstrap as u64;
+        let seed = self.seed;
+        let this = &*self;
+        // Importance of every bootstrap point, stratum by stratum; each point's numbers
+        // come from its own key, so the order of evaluation does not matter.
+        let evaluated: Vec<(f32, u64)> = (0..strata as u64 * n)
+            .into_par_iter()
+            .map_init(
+                || (T::Scratch::default(), Contributions::default()),
+                |(scratch, out), j| {
+                    let mut sampler = this.sampler(&[seed, BOOTSTRAP_KEY, j]);
+                    let stratum = (j / n) as usize;
+                    let e = this
+                        .target
+                        .evaluate(scene, &mut sampler, Some(stratum), scratch, out);
+                    (out.luminance as f32, e.rays)
+                },
+            )
+            .collect();
+        self.stats.rays += evaluated.iter().map(|e| e.1).sum::<u64>();
+        let importance: Vec<f32> = evaluated.into_iter().map(|e| e.0).collect();
+        let bootstrap = Bootstrap::new(&importance, strata, n);
+        self.target.set_stratum_means(&bootstrap.stratum_means);
+        if !(bootstrap.b > 0.0 && bootstrap.b.is_finite()) {
+            eprintln!(
+                "warning: {}: none of the {} bootstrap samples carried light to the film; \
+                 the image stays black",
+                self.name,
+                importance.len()
+            );
+            self.bootstrap = Some(bootstrap);
+            return;
+        }
+        // Systematic resampling in proportion to importance: chain k takes the point where
+        // the running sum crosses (k + ξ_k)/chains of the total.
+        let prefix: Vec<f64> = importance
+            .iter()
+            .scan(0.0f64, |acc, &x| {
+                *acc += x as f64;
+                Some(*acc)
+            })
+            .collect();
+        let total = *prefix.last().unwrap();
+        let chains = self.settings.chains as u64;
+        let this = &*self;
+        let started: Vec<Chain> = (0..chains)
+            .into_par_iter()
+            .map(|k| {
+                let xi = to_unit_f32(hash_words(&[seed, SELECT_KEY, k])) as f64;
+                let target_sum = (k as f64 + xi) / chains as f64 * total;
+                let j = prefix
+                    .partition_point(|&p| p <= target_sum)
+                    .min(prefix.len() - 1) as u64;
+                let stratum = (j / n) as usize;
+                let mut sampler = this.sampler(&[seed, BOOTSTRAP_KEY, j]);
+                let mut scratch = T::Scratch::default();
+                let mut out = Contributions::default();
+                this.target
+                    .evaluate(scene, &mut sampler, Some(stratum), &mut scratch, &mut out);
+                // The same point in the chain's coordinates, evaluated as a chain state.
+                this.target.to_chain_state(&mut sampler, stratum);
+                sampler.restart_evaluation();
+                this.target
+                    .evaluate(scene, &mut sampler, None, &mut scratch, &mut out);
+                sampler.start_chain(&[seed, CHAIN_KEY, k]);
+                Chain::new(sampler, out)
+            })
+            .collect();
+        self.chains = started;
+        self.bootstrap = Some(bootstrap);
+    }
+
+    /// The counts of every chain, summed.
+    pub fn counts(&self) -> ChainCounts {
+        let mut total = ChainCounts::default();
+        for c in &self.chains {
+            total.add(&c.counts);
+        }
+        total
+    }
+
+    /// The diagnostics so far (None before the first pass).
+    pub fn diagnostics_report(&self) -> Option<Diagnostics> {
+        let bootstrap = self.bootstrap.as_ref()?;
+        Some(Diagnostics::new(
+            self.name,
+            self.base,
+            &self.settings,
+            bootstrap,
+            &self.chains,
+            self.seconds,
+            self.bootstrap_seconds,
+        ))
+    }
+}
+
+impl<T: PathTarget> Estimator for Metropolis<T> {
+    fn name(&self) -> &str {
+        self.name
+    }
+
+    fn run_pass(&mut self, scene: &Scene, pass_index: u32) {
+        self.run_passes(scene, pass_index, 1);
+    }
+
+    fn run_passes(&mut self, scene: &Scene, _first: u32, count: u32) {
+        let start = Instant::now();
+        if self.bootstrap.is_none() {
+            self.start(scene);
+            self.bootstrap_seconds = start.elapsed().as_secs_f64();
+        }
+        self.stats.passes += count as u64;
+        if self.chains.is_empty() {
+            self.seconds += start.elapsed().as_secs_f64();
+            return;
+        }
+        let pixels = self.film.width() as u64 * self.film.height() as u64;
+        let n_chains = self.chains.len() as u64;
+        let settings = self.settings;
+        let b = self.bootstrap.as_ref().map_or(0.0, |s| s.b);
+        let target = &self.target;
+        // Each chain's splats, pass by pass.
+        let splats: Vec<Vec<SplatList>> = self
+            .chains
+            .par_iter_mut()
+            .enumerate()
+            .map(|(k, chain)| {
+                let mut scratch = T::Scratch::default();
+                (0..count)
+                    .map(|_| {
+                        let mut list = SplatList::new();
+                        for _ in 0..share(pixels, n_chains, k as u64) {
+                            chain.step(&settings, b, &mut list, |sampler, out| {
+                                let e = target.evaluate(scene, sampler, None, &mut scratch, out);
+                                (e.rays, e.invalid)
+                            });
+                        }
+                        list
+                    })
+                    .collect()
+            })
+            .collect();
+        for pass in 0..count as usize {
+            for chain in &splats {
+                self.film.merge_splats(&chain[pass]);
+            }
+        }
+        let counts = self.counts();
+        self.stats.samples = counts.steps();
+        self.stats.invalid_samples = counts.invalid;
+        self.seconds += start.elapsed().as_secs_f64();
+    }
+
+    fn image(&self) -> Image {
+        self.film.image_with_light_paths(self.stats.samples)
+    }
+
+    fn stats(&self) -> Stats {
+        let mut stats = self.stats.clone();
+        stats.rays += self.counts().rays;
+        stats
+    }
+
+    fn diagnostics(&self) -> Option<serde_json::Value> {
+        serde_json::to_value(self.diagnostics_report()?).ok()
+    }
+}

@@ -1,0 +1,206 @@
+//! `mmlt`'s path function: one path length and one bidirectional strategy per point of
+//! primary sample space (Hachisuka et al. 2014, "Multiplexed Metropolis light transport").
+//!
+//! The first number of the connection stream picks the path length d (segments, Mitsuba's
+//! count) with probability p(d) and, within it, one of the d + 1 strategies (s, t),
+//! s + t = d + 1, t ≥ 1, uniformly. Only that strategy is traced: a camera subpath of t
+//! vertices and a light subpath of s. Its contribution is the strategy's MIS-weighted
+//! value over the probability of picking it, C·w_(s,t)·(d + 1)/p(d), so the expected value
+//! over the first number is the sum over all strategies and lengths: the image.
+//!
+//! p(d) comes from the bootstrap, which runs per path length: p(d) ∝ b_d, the mean
+//! importance of length d, mixed with a uniform share (`UNIFORM_SHARE`) so that a length the
+//! bootstrap found dark can still be reached. p only changes how often large steps land
+//! on each length; the chain's stationary distribution spends time ∝ b_d on length d
+//! whatever p is.
+
+use crate::estimator::bdpt::Heuristic;
+use crate::estimator::camera_pass::camera_ray_in_image;
+use crate::estimator::mlt::target::{Contributions, Evaluation, PathTarget};
+use crate::path::connection;
+use crate::path::mis::PathDensity;
+use crate::path::settings::PathSettings;
+use crate::path::subpath::{camera_subpath, light_subpath};
+use crate::path::vertex::Vertex;
+use crate::sampler::primary_sample::PrimarySampleSampler;
+use crate::sampler::{Sampler, Stream};
+use crate::scene::Scene;
+
+/// The share of large steps spread uniformly over path lengths.
+const UNIFORM_SHARE: f64 = 0.05;
+
+pub struct MultiplexedTarget {
+    pub path: PathSettings,
+    pub mis: Heuristic,
+    /// The longest path length, `path.max_depth`.
+    max_depth: usize,
+    /// cdf[k] = p(1) + … + p(k) (cdf[0] = 0, cdf[max_depth] = 1).
+    cdf: Vec<f64>,
+}
+
+/// `MultiplexedTarget`'s buffers.
+#[derive(Default)]
+pub struct MultiplexedScratch<'a> {
+    camera_path: Vec<Vertex<'a>>,
+    light_path: Vec<Vertex<'a>>,
+    densities: Vec<PathDensity>,
+}
+
+impl MultiplexedTarget {
+    /// `max_depth` must be finite (`mmlt::new` checks).
+    pub fn new(path: PathSettings, mis: Heuristic, max_depth: u32) -> MultiplexedTarget {
+        let max_depth = max_depth as usize;
+        MultiplexedTarget {
+            path,
+            mis,
+            max_depth,
+            cdf: (0..=max_depth)
+                .map(|k| k as f64 / max_depth.max(1) as f64)
+                .collect(),
+        }
+    }
+
+    /// The probability of path length d (1-based).
+    pub fn length_probability(&self, d: usize) -> f64 {
+        self.cdf[d] - self.cdf[d - 1]
+    }
+
+    /// The path length whose interval of the cdf holds u.
+    fn length_of(&self, u: f64) -> usize {
+        // The first k with cdf[k] > u, skipping lengths of probability 0.
+        let k = self.cdf.partition_point(|&c| c <= u);
+        k.clamp(1, self.max_depth)
+    }
+}
+
+impl PathTarget for MultiplexedTarget {
+    type Scratch<'a> = MultiplexedScratch<'a>;
+
+    fn strata(&self) -> usize {
+        self.max_depth
+    }
+
+    fn evaluate<'a>(
+        &self,
+        scene: &'a Scene,
+        sampler: &mut impl Sampler,
+        stratum: Option<usize>,
+        scratch: &mut MultiplexedScratch<'a>,
+        out: &mut Contributions,
+    ) -> Evaluation {
+        out.clear();
+        let mut eval = Evaluation::default();
+        if self.max_depth == 0 {
+            return eval;
+        }
+        // The path length and strategy from the connection stream's first number.
+        sampler.start_stream(Stream::Connect);
+        let u = sampler.next_1d() as f64;
+        let (d, local, pick) = match stratum {
+            Some(k) => (k + 1, u, 1.0),
+            None => {
+                let d = self.length_of(u);
+                let p = self.length_probability(d);
+                ((d), ((u - self.cdf[d - 1]) / p).clamp(0.0, 1.0), p)
+            }
+        };
+        let strategies = d + 1;
+        let s = ((local * strategies as f64) as usize).min(d);
+        let t = d + 1 - s;
+        if s == 0 && t == 1 {
+            return eval;
+        }
+        let rr_depth = self.path.rr_depth;
+        let MultiplexedScratch {
+            camera_path,
+            light_path,
+            densities,
+        } = scratch;
+        let (raster, ray) = camera_ray_in_image(
+            &scene.camera,
+            {
+                let w = scene.description.sensor.film.window();
+                (w.width, w.height)
+            },
+            sampler,
+        );
+        eval.rays += camera_subpath(scene, ray, t - 1, rr_depth, sampler, camera_path);
+        if camera_path.len() < t {
+            return eval;
+        }
+        sampler.start_stream(Stream::Light);
+        let start = if s >= 1 {
+            let (start, rays) = light_subpath(scene, s - 1, rr_depth, sampler, light_path);
+            eval.rays += rays;
+            if light_path.len() < s {
+                return eval;
+            }
+            start
+        } else {
+            light_path.clear();
+            None
+        };
+        // Past the strategy choice, the connection stream's numbers.
+        sampler.start_stream(Stream::Connect);
+        let hide = self.path.hide_emitters;
+        let Some(c) = connection::connect(
+            scene,
+            light_path,
+            camera_path,
+            start.as_ref(),
+            s,
+            t,
+            hide,
+            sampler,
+        ) else {
+            return eval;
+        };
+        if c.value.is_black() {
+            return eval;
+        }
+        let w = connection::weight(
+            scene,
+            light_path,
+            camera_path,
+            c.sampled.as_ref(),
+            s,
+            t,
+            self.mis,
+            hide,
+            densities,
+        );
+        if let Some(shadow) = &c.shadow {
+            eval.rays += 1;
+            if scene.geometry.occluded(shadow) {
+                return eval;
+            }
+        }
+        let value = c.value * (w * (strategies as f64 / pick) as f32);
+        out.push(c.raster.unwrap_or(raster), value, &mut eval.invalid);
+        out.finish();
+        eval
+    }
+
+    fn set_stratum_means(&mut self, means: &[f64]) {
+        let total: f64 = means.iter().sum();
+        let n = self.max_depth as f64;
+        let mut acc = 0.0;
+        self.cdf = std::iter::once(0.0)
+            .chain(means.iter().map(|&b| {
+                let share = if total > 0.0 { b / total } else { 1.0 / n };
+                acc += (1.0 - UNIFORM_SHARE) * share + UNIFORM_SHARE / n;
+                acc
+            }))
+            .collect();
+        // The last entry is exactly 1 whatever the rounding.
+        if let Some(last) = self.cdf.last_mut() {
+            *last = 1.0;
+        }
+    }
+
+    fn to_chain_state(&self, sampler: &mut PrimarySampleSampler, stratum: usize) {
+        let d = stratum + 1;
+        let (lo, p) = (self.cdf[d - 1], self.length_probability(d));
+        sampler.map_value(Stream::Connect, 0, |local| lo + local * p);
+    }
+}

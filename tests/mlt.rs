@@ -1,0 +1,254 @@
+//! The Metropolis estimators `pssmlt` (over `pt` and over `bdpt`) and `mmlt` against `bdpt`
+//! (fixed seeds; Metropolis errors are correlated across pixels, so every tolerance comes
+//! from the spread of 8 or more independent runs):
+//!
+//! * every shipped scene: the image mean within 4 σ (Welch's t, at the two-sided tail of
+//!   4 σ of a normal) and every 16 × 16 block and channel (Welch's t, Šidák over all of
+//!   them at 10⁻³);
+//! * the normalisation b agrees with a long `bdpt` image's mean luminance within 4 of their
+//!   combined standard errors;
+//! * `large_step=1` (every proposal independent) agrees with the base estimator;
+//! * bit-identical images for 1 and 2 threads;
+//! * bad parameters, a scene without a light, a scene whose light reaches no pixel.
+
+mod render_support;
+
+use mltbench::estimator::{self, Params};
+use mltbench::image::Image;
+use mltbench::render::{Budget, render};
+use mltbench::scene::Scene;
+use render_support::*;
+use statrs::distribution::{ContinuousCDF, Normal, StudentsT};
+
+/// The Metropolis estimators as (estimator, its parameters).
+const METROPOLIS: [(&str, &str); 3] = [
+    ("pssmlt", "base=pt"),
+    ("pssmlt", "base=bdpt"),
+    ("mmlt", "large_step=0.3"),
+];
+
+/// Chain settings for short test runs: fewer chains and bootstrap samples than the
+/// defaults, so that each chain takes several hundred steps.
+const SHORT: [&str; 2] = ["chains=32", "bootstrap=20000"];
+
+fn runs(
+    name: &str,
+    scene: &Scene,
+    params: &[&str],
+    count: u64,
+    passes: u32,
+    seed: u64,
+) -> Vec<Image> {
+    (0..count)
+        .map(|k| render_with(name, scene, params, passes, seed + k))
+        .collect()
+}
+
+/// Asserts that the image means of runs `a` and `b` agree: Welch's t against the tail of
+/// 4 σ.
+fn assert_means_agree(what: &str, a: &[Image], b: &[Image]) {
+    for c in 0..3 {
+        let ((ma, sa), (mb, sb)) = (image_mean_over_runs(a, c), image_mean_over_runs(b, c));
+        let (va, vb) = (sa * sa, sb * sb);
+        let t = (ma - mb) / (va + vb).sqrt().max(1e-30);
+        let (na, nb) = (a.len() as f64 - 1.0, b.len() as f64 - 1.0);
+        let dof = ((va + vb).powi(2) / (va * va / na + vb * vb / nb)).max(1.0);
+        let p = 2.0 * StudentsT::new(0.0, 1.0, dof).unwrap().cdf(-t.abs());
+        let p_4sigma = 2.0 * Normal::new(0.0, 1.0).unwrap().cdf(-SIGMAS);
+        eprintln!("{what} channel {c}: {ma:.5} ± {sa:.1e} against {mb:.5} ± {sb:.1e}, p {p:.1e}");
+        assert!(
+            p > p_4sigma,
+            "{what} channel {c}: mean {ma} ± {sa} against {mb} ± {sb} (t = {t:.2}, p = {p:.1e})"
+        );
+    }
+}
+
+#[test]
+fn agrees_with_bdpt_on_every_shipped_scene() {
+    // The small light behind glass gives the path-traced chains rare, bright caustic paths:
+    // there a coarser film and more mutations per pixel, so that each run finds them.
+    for (file, res, passes, seed) in [
+        ("cbox.xml", 32, 32, 100),
+        ("cbox-dof.xml", 32, 32, 200),
+        ("cbox-point.xml", 32, 32, 300),
+        ("cbox-spheres.xml", 32, 32, 400),
+        ("cbox-smalllight.xml", 32, 32, 500),
+        ("cbox-spheres-smalllight.xml", 16, 256, 550),
+        ("cbox-mm.xml", 32, 32, 600),
+        ("envmap-spheres.xml", 32, 32, 700),
+        ("sun-room.xml", 32, 32, 800),
+        ("textures.xml", 32, 32, 900),
+        ("textures-plastic.xml", 32, 32, 950),
+    ] {
+        let scene = shipped_scene(file, res);
+        // mmlt needs a finite max_depth: the one scene with −1 gets 8 for every estimator.
+        let depth: &[&str] = if file == "textures-plastic.xml" {
+            &["max_depth=8"]
+        } else {
+            &[]
+        };
+        let bdpt = runs("bdpt", &scene, depth, 8, passes, seed);
+        for (k, (name, param)) in METROPOLIS.iter().enumerate() {
+            let mut params = vec![*param];
+            params.extend(SHORT);
+            params.extend(depth);
+            let mlt = runs(name, &scene, &params, 8, passes, seed + 10 * (k as u64 + 1));
+            let what = format!("{file}: {name} {param}");
+            assert_means_agree(&what, &mlt, &bdpt);
+            assert_blocks_agree_of(&what, &mlt, &bdpt, 16);
+        }
+    }
+}
+
+/// The bootstrap's normalisation b is the mean luminance of the image.
+#[test]
+fn normalisation_is_the_image_mean_luminance() {
+    let scene = shipped_scene("cbox-spheres.xml", 32);
+    let bdpt = runs("bdpt", &scene, &[], 8, 64, 3000);
+    let luminance = |im: &Image| {
+        im.pixels.iter().map(|p| p.luminance() as f64).sum::<f64>() / im.pixels.len() as f64
+    };
+    let (mean, se) = mean_and_standard_error(&bdpt.iter().map(luminance).collect::<Vec<_>>());
+    for (name, param) in METROPOLIS {
+        let params = Params::parse(&[param, "bootstrap=100000"]).unwrap();
+        let mut e = estimator::create(name, &params, &scene, 7).unwrap();
+        render(&scene, e.as_mut(), Budget::Passes(1), |_, _| {});
+        let d = e.diagnostics().expect("diagnostics");
+        let b = d["bootstrap"]["b"].as_f64().unwrap();
+        let b_se = d["bootstrap"]["b_standard_error"].as_f64().unwrap();
+        let sigma = (se * se + b_se * b_se).sqrt();
+        eprintln!("{name} {param}: b {b:.5} ± {b_se:.1e}, bdpt {mean:.5} ± {se:.1e}");
+        assert!(
+            (b - mean).abs() < SIGMAS * sigma,
+            "{name} {param}: b = {b} ± {b_se} against the image's {mean} ± {se}"
+        );
+    }
+}
+
+/// With large_step=1 every proposal is an independent sample: the chain is then an
+/// independence sampler and agrees with its base estimator.
+#[test]
+fn large_steps_only_agree_with_the_base_estimator() {
+    let scene = shipped_scene("cbox-spheres.xml", 32);
+    for (base, seed) in [("pt", 4000), ("bdpt", 4100)] {
+        let own = runs(base, &scene, &[], 8, 32, seed);
+        let param = format!("base={base}");
+        let mut params = vec![param.as_str(), "large_step=1"];
+        params.extend(SHORT);
+        let mlt = runs("pssmlt", &scene, &params, 8, 32, seed + 50);
+        let what = format!("pssmlt base={base} large_step=1");
+        assert_means_agree(&what, &mlt, &own);
+        assert_blocks_agree_of(&what, &mlt, &own, 16);
+    }
+}
+
+#[test]
+fn thread_count_does_not_matter() {
+    let scene = shipped_scene("cbox-spheres.xml", 40);
+    for (name, param) in METROPOLIS {
+        let bits = |threads: usize, seed: u64| -> Vec<u32> {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let params = Params::parse(&[param, "chains=48", "bootstrap=5000"]).unwrap();
+            let mut e = estimator::create(name, &params, &scene, seed).unwrap();
+            let image = pool
+                .install(|| render(&scene, e.as_mut(), Budget::Passes(6), |_, _| {}))
+                .image;
+            assert!(image.pixels.iter().any(|p| !p.is_black()));
+            image
+                .pixels
+                .iter()
+                .flat_map(|p| p.0.map(f32::to_bits))
+                .collect()
+        };
+        let one = bits(1, 5);
+        assert_eq!(one, bits(2, 5), "{name} {param}: 1 and 2 threads");
+        assert_ne!(
+            one,
+            bits(2, 6),
+            "{name} {param}: another seed, another image"
+        );
+    }
+}
+
+#[test]
+fn bad_parameters_are_refused_naming_them() {
+    let scene = shipped_scene("cbox.xml", 8);
+    for name in ["pssmlt", "mmlt"] {
+        for (param, expected) in [
+            ("large_step=1.5", "large_step"),
+            ("large_step=-1", "large_step"),
+            ("chains=0", "chains"),
+            ("s1=0.1", "s2"),
+            ("bootstrap=0", "bootstrap"),
+            ("wavefront=false", "wavefront"),
+            ("strategies=true", "strategies"),
+        ] {
+            let err = estimator::create(name, &Params::parse(&[param]).unwrap(), &scene, 1)
+                .err()
+                .unwrap_or_else(|| panic!("{name} {param} accepted"))
+                .to_string();
+            assert!(err.contains(expected), "{name} {param}: {err}");
+        }
+    }
+    let err = estimator::create("pssmlt", &Params::parse(&["base=lt"]).unwrap(), &scene, 1)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("base"), "{err}");
+    let err = estimator::create(
+        "mmlt",
+        &Params::parse(&["max_depth=-1"]).unwrap(),
+        &scene,
+        1,
+    )
+    .err()
+    .unwrap()
+    .to_string();
+    assert!(err.contains("max_depth"), "{err}");
+}
+
+#[test]
+fn a_scene_without_light_is_an_error_naming_it() {
+    let xml = format!(
+        r#"<scene version="3.0.0">{}<shape type="sphere"><float name="radius" value="1"/></shape></scene>"#,
+        camera()
+    );
+    let scene = render_support::scene(&xml);
+    for name in ["pssmlt", "mmlt"] {
+        let err = estimator::create(name, &Params::default(), &scene, 1)
+            .err()
+            .unwrap_or_else(|| panic!("{name} accepted a scene without light"))
+            .to_string();
+        assert!(
+            err.contains("test-scene.xml") && err.contains("no light"),
+            "{err}"
+        );
+    }
+}
+
+/// A light that reaches no pixel (inside a closed box the camera looks at from outside):
+/// every bootstrap sample is zero, the image is black, nothing fails.
+#[test]
+fn a_light_that_reaches_no_pixel_renders_black() {
+    let xml = format!(
+        r#"<scene version="3.0.0">{}
+        <shape type="cube"><transform name="to_world"><scale value="0.5"/></transform>
+            <bsdf type="diffuse"/></shape>
+        <shape type="sphere"><float name="radius" value="0.1"/>
+            <emitter type="area"><rgb name="radiance" value="5"/></emitter></shape>
+        </scene>"#,
+        camera()
+    );
+    let scene = render_support::scene(&xml);
+    for (name, param) in METROPOLIS {
+        let params = Params::parse(&[param, "bootstrap=2000", "chains=8", "max_depth=6"]).unwrap();
+        let mut e = estimator::create(name, &params, &scene, 1).unwrap();
+        let out = render(&scene, e.as_mut(), Budget::Passes(2), |_, _| {});
+        assert!(out.image.pixels.iter().all(|p| p.is_black()), "{name}");
+        let d = e.diagnostics().unwrap();
+        assert_eq!(d["bootstrap"]["nonzero"].as_u64(), Some(0));
+    }
+}
