@@ -10,6 +10,8 @@ use serde_json::Value;
 
 use super::Experiment;
 use super::runner::ResultsDir;
+use crate::error::{Error, Result};
+use crate::io::atomic::write_file_atomically;
 
 /// The numbers the table shows, read from one run's JSON.
 struct RunDiagnostics {
@@ -57,16 +59,42 @@ fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
-/// The section, or None when no cell wrote diagnostics.
-pub fn readme_section(experiment: &Experiment, results: &ResultsDir) -> Option<String> {
+/// Every Metropolis estimator's per-run diagnostics as its cells wrote them, in the
+/// spec's order; estimators without diagnostics are left out.
+pub fn collect(experiment: &Experiment, results: &ResultsDir) -> Vec<(String, Vec<Value>)> {
+    experiment
+        .estimators
+        .iter()
+        .map(|entry| {
+            let runs: Vec<Value> = (0..experiment.runs)
+                .filter_map(|r| {
+                    let path = results.cell_diagnostics(&entry.label, r);
+                    serde_json::from_str(&std::fs::read_to_string(path).ok()?).ok()
+                })
+                .collect();
+            (entry.label.clone(), runs)
+        })
+        .filter(|(_, runs)| !runs.is_empty())
+        .collect()
+}
+
+/// `chains.json`: the collected diagnostics, kept with the report (the cells are working
+/// files and not committed).
+pub fn write_json(path: &std::path::Path, collected: &[(String, Vec<Value>)]) -> Result<()> {
+    let map: serde_json::Map<String, Value> = collected
+        .iter()
+        .map(|(label, runs)| (label.clone(), Value::Array(runs.clone())))
+        .collect();
+    let text = serde_json::to_string_pretty(&Value::Object(map))
+        .map_err(|e| Error::io(path, std::io::Error::other(e)))?;
+    write_file_atomically(path, (text + "\n").as_bytes())
+}
+
+/// The section, or None when no estimator wrote diagnostics.
+pub fn readme_section(collected: &[(String, Vec<Value>)]) -> Option<String> {
     let mut md = String::new();
-    for entry in &experiment.estimators {
-        let runs: Vec<RunDiagnostics> = (0..experiment.runs)
-            .filter_map(|r| {
-                let text = std::fs::read_to_string(results.cell_diagnostics(&entry.label, r));
-                read(&serde_json::from_str(&text.ok()?).ok()?)
-            })
-            .collect();
+    for (label, values) in collected {
+        let runs: Vec<RunDiagnostics> = values.iter().filter_map(read).collect();
         if runs.is_empty() {
             continue;
         }
@@ -77,7 +105,7 @@ pub fn readme_section(experiment: &Experiment, results: &ResultsDir) -> Option<S
         let _ = writeln!(
             md,
             "| {} | {} | {:.3} | {:.3} | {:.3} | {:.4e} ± {:.1e} | {:.1} / {:.0} | {} | {} | {:.3e} |",
-            entry.label,
+            label,
             runs.len(),
             m(|r| r.acceptance),
             m(|r| r.small),
@@ -106,6 +134,6 @@ pub fn readme_section(experiment: &Experiment, results: &ResultsDir) -> Option<S
          steps; ≥ where the window never closed), the effective sample size (mutations / τ) \
          and mutations per second.\n\n\
          | estimator | runs | accept | small | large | b ± s.e. | never moved | τ | ESS | mutations/s |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n{md}"
+         |---|---|---|---|---|---|---|---|---|---|\n{md}\nPer run: `chains.json`.\n"
     ))
 }

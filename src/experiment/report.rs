@@ -331,9 +331,13 @@ pub fn report(
     write_file_atomically(&dir.join("summary.csv"), summary_csv(&summary).as_bytes())?;
     let json = serde_json::to_string_pretty(&summary).expect("summary serialises");
     write_file_atomically(&dir.join("summary.json"), json.as_bytes())?;
+    let chains = super::chain_diagnostics::collect(experiment, results);
+    if !chains.is_empty() {
+        super::chain_diagnostics::write_json(&dir.join("chains.json"), &chains)?;
+    }
     write_file_atomically(
         &dir.join("README.md"),
-        readme(experiment, results, &summary, reference).as_bytes(),
+        readme(experiment, results, &summary, reference, &chains).as_bytes(),
     )?;
     Ok(summary)
 }
@@ -420,6 +424,7 @@ fn readme(
     results: &ResultsDir,
     s: &Summary,
     reference: &Reference,
+    chains: &[(String, Vec<serde_json::Value>)],
 ) -> String {
     let mut md = String::new();
     let _ = writeln!(md, "# Experiment `{}`\n\n{}\n", s.experiment, s.description);
@@ -543,7 +548,7 @@ fn readme(
     let _ = writeln!(md, "![relMSE against passes](convergence-passes.png)\n");
     let _ = writeln!(md, "![bias² and variance against time](bias.png)\n");
     let _ = writeln!(md, "![final images and relative-error maps](contact.png)\n");
-    if let Some(section) = super::chain_diagnostics::readme_section(experiment, results) {
+    if let Some(section) = super::chain_diagnostics::readme_section(chains) {
         md.push_str(&section);
     }
     if let Some(section) = super::strategies::readme_section(experiment, results) {
