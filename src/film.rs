@@ -157,6 +157,34 @@ impl ReconstructionFilter {
         }
     }
 
+    /// An offset t ∈ [a, b] (pixels from a pixel centre) drawn from `u` with density
+    /// ∝ the filter over that interval (which should overlap the support): uniform for the
+    /// box, by bisection on `integral` for the Gaussian. Sampling a pixel's positions so
+    /// makes each sample's plain mean the filtered pixel value (photon mapping's eye pass).
+    pub fn sample_offset(&self, u: f64, a: f64, b: f64) -> f64 {
+        let r = self.radius();
+        let (a, b) = (a.max(-r), b.min(r));
+        if b <= a {
+            return a.clamp(-r, r);
+        }
+        match *self {
+            ReconstructionFilter::Box => a + u * (b - a),
+            ReconstructionFilter::Gaussian { .. } => {
+                let target = u * self.integral(a, b);
+                let (mut lo, mut hi) = (a, b);
+                for _ in 0..48 {
+                    let mid = 0.5 * (lo + hi);
+                    if self.integral(a, mid) < target {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                0.5 * (lo + hi)
+            }
+        }
+    }
+
     /// How many pixels beyond a tile's rectangle a sample inside it (edges included) can
     /// reach.
     fn margin(&self) -> u32 {

@@ -215,7 +215,7 @@ fn run_render(args: RenderArgs) -> Result<bool> {
         .clone()
         .unwrap_or_else(|| default_output(&args.common.scene));
     // Refused now rather than after the render: its result would be lost.
-    let mut sidecars = io::outputs::check_outputs(&output, &["png", "chains.json"])?;
+    let mut sidecars = io::outputs::check_outputs(&output, &["png", "diagnostics.json"])?;
     // The JSON is written only by estimators with diagnostics (`pssmlt`, `mmlt`).
     let diagnostics_path = sidecars.pop().unwrap();
     let preview = sidecars.remove(0);

@@ -11,6 +11,7 @@ pub mod eyelight;
 pub mod lt;
 pub mod mlt;
 pub mod params;
+pub mod ppm;
 pub mod pt;
 
 pub use params::Params;
@@ -66,7 +67,7 @@ pub trait Estimator: Send {
 }
 
 /// Names of the estimators this build knows, for `--help` and error messages.
-pub const ESTIMATOR_NAMES: &[&str] = &["pt", "lt", "bdpt", "pssmlt", "mmlt", "eyelight"];
+pub const ESTIMATOR_NAMES: &[&str] = &["pt", "lt", "bdpt", "pssmlt", "mmlt", "ppm", "eyelight"];
 
 /// Fails, listing the known names, unless `name` is one of `ESTIMATOR_NAMES`: for commands
 /// to check before they load a scene.
@@ -107,6 +108,11 @@ pub fn create(name: &str, params: &Params, scene: &Scene, seed: u64) -> Result<B
         ),
         "pssmlt" => mlt::pssmlt(params, scene, seed)?,
         "mmlt" => Box::new(mlt::mmlt(params, scene, seed)?),
+        "ppm" => Box::new(ppm::new(
+            scene,
+            seed,
+            ppm::PpmSettings::from_params(params, scene)?,
+        )?),
         _ => return Err(unknown_estimator(name)),
     };
     params.check_all_used(name)?;

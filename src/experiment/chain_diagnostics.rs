@@ -78,7 +78,7 @@ pub fn collect(experiment: &Experiment, results: &ResultsDir) -> Vec<(String, Ve
         .collect()
 }
 
-/// `chains.json`: the collected diagnostics, kept with the report (the cells are working
+/// `diagnostics.json`: the collected diagnostics, kept with the report (the cells are working
 /// files and not committed).
 pub fn write_json(path: &std::path::Path, collected: &[(String, Vec<Value>)]) -> Result<()> {
     let map: serde_json::Map<String, Value> = collected
@@ -134,6 +134,6 @@ pub fn readme_section(collected: &[(String, Vec<Value>)]) -> Option<String> {
          steps; ≥ where the window never closed), the effective sample size (mutations / τ) \
          and mutations per second.\n\n\
          | estimator | runs | accept | small | large | b ± s.e. | never moved | τ | ESS | mutations/s |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n{md}\nPer run: `chains.json`.\n"
+         |---|---|---|---|---|---|---|---|---|---|\n{md}\nPer run: `diagnostics.json`.\n"
     ))
 }

@@ -333,7 +333,7 @@ pub fn report(
     write_file_atomically(&dir.join("summary.json"), json.as_bytes())?;
     let chains = super::chain_diagnostics::collect(experiment, results);
     if !chains.is_empty() {
-        super::chain_diagnostics::write_json(&dir.join("chains.json"), &chains)?;
+        super::chain_diagnostics::write_json(&dir.join("diagnostics.json"), &chains)?;
     }
     write_file_atomically(
         &dir.join("README.md"),
