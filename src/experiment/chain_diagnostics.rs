@@ -59,7 +59,7 @@ fn mean(values: impl Iterator<Item = f64>) -> Option<f64> {
     (!v.is_empty()).then(|| v.iter().sum::<f64>() / v.len() as f64)
 }
 
-/// Every Metropolis estimator's per-run diagnostics as its cells wrote them, in the
+/// Every estimator's per-run diagnostics (chains, photon maps) as its cells wrote them, in the
 /// spec's order; estimators without diagnostics are left out.
 pub fn collect(experiment: &Experiment, results: &ResultsDir) -> Vec<(String, Vec<Value>)> {
     experiment
@@ -127,13 +127,13 @@ pub fn readme_section(collected: &[(String, Vec<Value>)]) -> Option<String> {
     }
     Some(format!(
         "\n## Markov chains\n\nMeans over runs of each Metropolis estimator's chain diagnostics \
-         (`cells/*.json`): acceptance overall and of small and large steps, the \
+         (`diagnostics.json`): acceptance overall and of small and large steps, the \
          normalisation b (mean luminance of the bootstrap) with its standard error, chains \
          that never moved out of all chains, the integrated autocorrelation time τ of the \
          chains' importance in mutations (Sokal's automatic window over each chain's first \
          steps; ≥ where the window never closed), the effective sample size (mutations / τ) \
          and mutations per second.\n\n\
          | estimator | runs | accept | small | large | b ± s.e. | never moved | τ | ESS | mutations/s |\n\
-         |---|---|---|---|---|---|---|---|---|---|\n{md}\nPer run: `diagnostics.json`.\n"
+         |---|---|---|---|---|---|---|---|---|---|\n{md}\nPer run: `diagnostics.json`.\n\n"
     ))
 }

@@ -12,6 +12,7 @@
 
 pub mod chain_diagnostics;
 pub mod metrics;
+pub mod photon_diagnostics;
 pub mod plot;
 pub mod reference;
 pub mod report;

@@ -551,6 +551,9 @@ fn readme(
     if let Some(section) = super::chain_diagnostics::readme_section(chains) {
         md.push_str(&section);
     }
+    if let Some(section) = super::photon_diagnostics::readme_section(chains) {
+        md.push_str(&section);
+    }
     if let Some(section) = super::strategies::readme_section(experiment, results) {
         md.push_str(&section);
     }
