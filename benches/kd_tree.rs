@@ -15,31 +15,23 @@ use kiddo::SquaredEuclidean;
 use kiddo::immutable::float::kdtree::ImmutableKdTree;
 use mltbench::estimator::ppm::kd_tree::{KdTree, distance_squared};
 
-/// SplitMix64 (Steele et al. 2014), for the point sets.
-struct SplitMix(u64);
+#[path = "support/split_mix.rs"]
+mod split_mix;
+use split_mix::SplitMix;
 
-impl SplitMix {
-    fn next_f32(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-
-    fn point(&mut self) -> Vec3 {
-        Vec3::new(self.next_f32(), self.next_f32(), self.next_f32())
-    }
+/// A uniform point in the unit cube.
+fn point(rng: &mut SplitMix) -> Vec3 {
+    Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32())
 }
 
 fn uniform(n: usize, seed: u64) -> Vec<Vec3> {
     let mut rng = SplitMix(seed);
-    (0..n).map(|_| rng.point()).collect()
+    (0..n).map(|_| point(&mut rng)).collect()
 }
 
 fn clustered(n: usize, seed: u64) -> Vec<Vec3> {
     let mut rng = SplitMix(seed);
-    let centres: Vec<Vec3> = (0..5).map(|_| rng.point()).collect();
+    let centres: Vec<Vec3> = (0..5).map(|_| point(&mut rng)).collect();
     (0..n)
         .map(|i| {
             let mut j = || (rng.next_f32() + rng.next_f32() - 1.0) * 0.02;
@@ -56,7 +48,7 @@ fn queries(points: &[Vec3], seed: u64) -> Vec<Vec3> {
     (0..QUERIES)
         .map(|i| {
             let p = points[(i * 7919) % points.len()];
-            p + (rng.point() - 0.5) * 1e-3
+            p + (point(&mut rng) - 0.5) * 1e-3
         })
         .collect()
 }

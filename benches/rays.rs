@@ -38,18 +38,9 @@ const HEIGHT: u32 = 512;
 /// Rays per parallel work item (8 image rows: keeps coherent rays together).
 const CHUNK: usize = 8 * WIDTH as usize;
 
-/// SplitMix64 (Steele et al. 2014): a small, seedable generator for the ray sets.
-struct SplitMix(u64);
-
-impl SplitMix {
-    fn next_f32(&mut self) -> f32 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
+#[path = "support/split_mix.rs"]
+mod split_mix;
+use split_mix::SplitMix;
 
 /// Camera rays of a pinhole at `eye` looking at `target` (vertical field of view `fov_y`
 /// degrees), one jittered ray per pixel, in scanline order.

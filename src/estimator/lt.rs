@@ -219,13 +219,7 @@ impl Estimator for LightTracer {
                 let mut sampler = IndependentSampler::new(self.seed);
                 let first = b as u64 * PATHS_PER_BLOCK;
                 for path in first..(first + PATHS_PER_BLOCK).min(n) {
-                    // A stream per (pass, path): the pixel-sample key with the path index
-                    // in place of the pixel.
-                    let key = (
-                        (path & 0xFFFF_FFFF) as u32,
-                        STREAM_TAG | (path >> 32) as u32,
-                    );
-                    sampler.start_pixel_sample(key, pass_index as u64);
+                    sampler.start_light_path(path, STREAM_TAG, pass_index as u64);
                     self.trace(scene, &mut sampler, splats, &mut counts);
                 }
                 counts

@@ -82,6 +82,14 @@ impl IndependentSampler {
         let key = hash_words(&[self.seed, pixel.0 as u64, pixel.1 as u64, sample_index]);
         self.rng = Xoshiro256PlusPlus::seed_from_u64(key);
     }
+
+    /// Starts light path `path` of pass `pass`, its streams kept apart from every pixel
+    /// sample and from other light-path estimators' by `tag` (whose low 16 bits are 0):
+    /// the pixel-sample key with the path index in place of the pixel.
+    pub fn start_light_path(&mut self, path: u64, tag: u32, pass: u64) {
+        let key = ((path & 0xFFFF_FFFF) as u32, tag | (path >> 32) as u32);
+        self.start_pixel_sample(key, pass);
+    }
 }
 
 impl Sampler for IndependentSampler {

@@ -112,7 +112,6 @@ impl KdTree {
         if self.entries.is_empty() || r2.is_nan() || r2 < 0.0 {
             return;
         }
-        let q = centre.to_array();
         let mut stack: [(u32, u32); 64] = [(0, 0); 64];
         let mut top = 1;
         stack[0] = (0, self.entries.len() as u32);
@@ -127,13 +126,7 @@ impl KdTree {
                 if d2 <= r2 {
                     visit(node.id, d2);
                 }
-                let axis = self.axes[mid] as usize;
-                let diff = q[axis] - node.p[axis];
-                let (near, far) = if diff < 0.0 {
-                    ((lo, mid), (mid + 1, hi))
-                } else {
-                    ((mid + 1, hi), (lo, mid))
-                };
+                let Split { near, far, diff } = self.split(lo, mid, hi, centre);
                 if diff * diff <= r2 {
                     stack[top] = (far.0 as u32, far.1 as u32);
                     top += 1;
@@ -168,7 +161,6 @@ impl KdTree {
                 best.push(candidate);
             }
         };
-        let q = centre.to_array();
         let mut stack: [(u32, u32, f32); 64] = [(0, 0, 0.0); 64];
         let mut top = 1;
         stack[0] = (0, self.entries.len() as u32, 0.0);
@@ -192,13 +184,7 @@ impl KdTree {
                 let mid = lo + (hi - lo) / 2;
                 let node = &self.entries[mid];
                 offer(&mut best, node);
-                let axis = self.axes[mid] as usize;
-                let diff = q[axis] - node.p[axis];
-                let (near, far) = if diff < 0.0 {
-                    ((lo, mid), (mid + 1, hi))
-                } else {
-                    ((mid + 1, hi), (lo, mid))
-                };
+                let Split { near, far, diff } = self.split(lo, mid, hi, centre);
                 let d2 = diff * diff;
                 if d2 <= worst(&best) {
                     stack[top] = (far.0 as u32, far.1 as u32, d2);
@@ -215,6 +201,29 @@ impl KdTree {
                 .into_iter()
                 .map(|c| (f32::from_bits((c >> 32) as u32), c as u32)),
         );
+    }
+}
+
+/// The children of an internal node, the one on the query's side first.
+struct Split {
+    near: (usize, usize),
+    far: (usize, usize),
+    /// The query's signed distance from the splitting plane.
+    diff: f32,
+}
+
+impl KdTree {
+    /// Splits the node of slots [lo, hi) with median `mid` for a query at `centre`.
+    #[inline]
+    fn split(&self, lo: usize, mid: usize, hi: usize, centre: Vec3) -> Split {
+        let axis = self.axes[mid] as usize;
+        let diff = centre[axis] - self.entries[mid].p[axis];
+        let (near, far) = if diff < 0.0 {
+            ((lo, mid), (mid + 1, hi))
+        } else {
+            ((mid + 1, hi), (lo, mid))
+        };
+        Split { near, far, diff }
     }
 }
 

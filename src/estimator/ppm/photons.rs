@@ -61,11 +61,7 @@ pub fn trace_photons(
             let mut sampler = IndependentSampler::new(seed);
             let first = b * PATHS_PER_BLOCK;
             for path in first..(first + PATHS_PER_BLOCK).min(paths) {
-                let key = (
-                    (path & 0xFFFF_FFFF) as u32,
-                    STREAM_TAG | (path >> 32) as u32,
-                );
-                sampler.start_pixel_sample(key, pass);
+                sampler.start_light_path(path, STREAM_TAG, pass);
                 sampler.start_stream(Stream::Light);
                 let Some(start) = start_light(scene, &mut sampler) else {
                     continue;

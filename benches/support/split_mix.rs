@@ -1,0 +1,14 @@
+//! A small seedable generator shared by the benches' point and ray sets.
+
+/// SplitMix64 (Steele et al. 2014): a small, seedable generator for the point and ray sets.
+pub struct SplitMix(pub u64);
+
+impl SplitMix {
+    pub fn next_f32(&mut self) -> f32 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        ((z ^ (z >> 31)) >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
