@@ -282,7 +282,7 @@ fn run_render(args: RenderArgs) -> Result<bool> {
         let text = serde_json::to_string_pretty(&diagnostics).unwrap_or_default() + "\n";
         io::atomic::write_file_atomically(&diagnostics_path, text.as_bytes())?;
         eprintln!(
-            "{}: chain diagnostics -> {}",
+            "{}: diagnostics -> {}",
             args.common.estimator,
             diagnostics_path.display()
         );

@@ -60,7 +60,8 @@ pub trait Estimator: Send {
         None
     }
     /// What the estimator reports about itself beyond `stats`, as JSON written beside its
-    /// images (the Metropolis estimators' chain diagnostics); None for most.
+    /// images (the Metropolis estimators' chain diagnostics, photon mapping's map
+    /// statistics); None for most.
     fn diagnostics(&self) -> Option<serde_json::Value> {
         None
     }

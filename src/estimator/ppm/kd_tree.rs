@@ -15,12 +15,10 @@
 //! computed by `distance_squared` alone, so a brute-force scan with it finds exactly the
 //! same points (the pruning test is exact under rounding: see `within_radius`).
 
-use std::collections::BinaryHeap;
-
 use glam::Vec3;
 
 /// Points a leaf holds at most.
-pub const LEAF_SIZE: usize = 8;
+pub const LEAF_SIZE: usize = 32;
 
 /// Ranges larger than this build their two halves in parallel.
 const PARALLEL_BUILD: usize = 1 << 15;
@@ -103,21 +101,24 @@ impl KdTree {
     /// Calls `visit(index, d²)` for every point with d² = `distance_squared` ≤ radius², in
     /// tree order.
     ///
-    /// A subtree beyond the split plane is skipped when (q − s)² > radius² along the split
-    /// axis. That is exact in floating point: every point p in it has |q − p| ≥ |q − s| on
-    /// that axis, rounding is monotone, and a rounded sum of non-negative squares is at
-    /// least each of its terms, so its d² exceeds radius² too.
+    /// A subtree is skipped when its cell lies beyond the sphere: the query's distance to
+    /// the cell along each axis (the nearest split plane of that axis crossed to reach it,
+    /// Arya and Mount 1993's incremental distance) gives a lower bound on d², summed as
+    /// `distance_squared` sums. The test is exact in floating point: every point p in the
+    /// cell has |q − p| ≥ that distance on each axis, rounding is monotone, and so is a
+    /// rounded sum of non-negative terms, so the bound never exceeds p's own d².
     pub fn within_radius(&self, centre: Vec3, radius: f32, mut visit: impl FnMut(u32, f32)) {
         let r2 = radius * radius;
         if self.entries.is_empty() || r2.is_nan() || r2 < 0.0 {
             return;
         }
-        let mut stack: [(u32, u32); 64] = [(0, 0); 64];
+        let mut stack: [Cell; 64] = [Cell::default(); 64];
         let mut top = 1;
-        stack[0] = (0, self.entries.len() as u32);
+        stack[0] = Cell::root(self.entries.len());
         while top > 0 {
             top -= 1;
-            let (mut lo, mut hi) = (stack[top].0 as usize, stack[top].1 as usize);
+            let Cell { lo, hi, offset } = stack[top];
+            let (mut lo, mut hi) = (lo as usize, hi as usize);
             // Descend towards the query point, pushing far sides that the sphere reaches.
             while hi - lo > LEAF_SIZE {
                 let mid = lo + (hi - lo) / 2;
@@ -126,12 +127,13 @@ impl KdTree {
                 if d2 <= r2 {
                     visit(node.id, d2);
                 }
-                let Split { near, far, diff } = self.split(lo, mid, hi, centre);
-                if diff * diff <= r2 {
-                    stack[top] = (far.0 as u32, far.1 as u32);
+                let split = self.split(lo, mid, hi, centre);
+                let far = Cell::far(&split, self.axes[mid], offset);
+                if far.bound() <= r2 {
+                    stack[top] = far;
                     top += 1;
                 }
-                (lo, hi) = near;
+                (lo, hi) = split.near;
             }
             for e in &self.entries[lo..hi] {
                 let d2 = distance_squared(centre, Vec3::from_array(e.p));
@@ -149,58 +151,95 @@ impl KdTree {
         if k == 0 || self.entries.is_empty() {
             return;
         }
-        // Keys order by (d², index): d² ≥ 0 is finite, so its bits order as the value.
+        // Keys order by (d², index): d² ≥ 0 is finite, so its bits order as the value. The
+        // best k are kept sorted (k is small: an insertion beats a heap).
         let key = |d2: f32, id: u32| ((d2.to_bits() as u64) << 32) | id as u64;
-        let mut best: BinaryHeap<u64> = BinaryHeap::with_capacity(k + 1);
-        let offer = |best: &mut BinaryHeap<u64>, e: &Entry| {
+        let mut best: Vec<u64> = Vec::with_capacity(k + 1);
+        let offer = |best: &mut Vec<u64>, e: &Entry| {
             let candidate = key(distance_squared(centre, Vec3::from_array(e.p)), e.id);
-            if best.len() < k {
-                best.push(candidate);
-            } else if candidate < *best.peek().unwrap() {
-                best.pop();
-                best.push(candidate);
+            if best.len() < k || candidate < best[k - 1] {
+                let at = best.partition_point(|&b| b < candidate);
+                best.insert(at, candidate);
+                best.truncate(k);
             }
         };
-        let mut stack: [(u32, u32, f32); 64] = [(0, 0, 0.0); 64];
+        // The worst kept distance so far; a cell no nearer cannot improve (a tie at equal
+        // distance may, by index: hence >, not ≥).
+        let worst = |best: &Vec<u64>| {
+            if best.len() < k {
+                f32::INFINITY
+            } else {
+                f32::from_bits((best[k - 1] >> 32) as u32)
+            }
+        };
+        let mut stack: [Cell; 64] = [Cell::default(); 64];
         let mut top = 1;
-        stack[0] = (0, self.entries.len() as u32, 0.0);
+        stack[0] = Cell::root(self.entries.len());
         while top > 0 {
             top -= 1;
-            let (lo, hi, plane_d2) = stack[top];
-            let (mut lo, mut hi) = (lo as usize, hi as usize);
-            // The worst kept distance so far; a far side no nearer cannot improve (a tie
-            // at equal distance may, by index: hence >, not ≥).
-            let worst = |best: &BinaryHeap<u64>| {
-                if best.len() < k {
-                    f32::INFINITY
-                } else {
-                    f32::from_bits((best.peek().unwrap() >> 32) as u32)
-                }
-            };
-            if plane_d2 > worst(&best) {
+            let cell = stack[top];
+            if cell.bound() > worst(&best) {
                 continue;
             }
+            let (mut lo, mut hi) = (cell.lo as usize, cell.hi as usize);
             while hi - lo > LEAF_SIZE {
                 let mid = lo + (hi - lo) / 2;
-                let node = &self.entries[mid];
-                offer(&mut best, node);
-                let Split { near, far, diff } = self.split(lo, mid, hi, centre);
-                let d2 = diff * diff;
-                if d2 <= worst(&best) {
-                    stack[top] = (far.0 as u32, far.1 as u32, d2);
+                offer(&mut best, &self.entries[mid]);
+                let split = self.split(lo, mid, hi, centre);
+                let far = Cell::far(&split, self.axes[mid], cell.offset);
+                if far.bound() <= worst(&best) {
+                    stack[top] = far;
                     top += 1;
                 }
-                (lo, hi) = near;
+                (lo, hi) = split.near;
             }
             for e in &self.entries[lo..hi] {
                 offer(&mut best, e);
             }
         }
         out.extend(
-            best.into_sorted_vec()
-                .into_iter()
+            best.into_iter()
                 .map(|c| (f32::from_bits((c >> 32) as u32), c as u32)),
         );
+    }
+}
+
+/// A subtree waiting on a query's stack: its slots and the query's distance to its cell
+/// along each axis (0 on an axis where the query lies within the cell's extent).
+#[derive(Clone, Copy, Default)]
+struct Cell {
+    lo: u32,
+    hi: u32,
+    offset: [f32; 3],
+}
+
+impl Cell {
+    fn root(len: usize) -> Cell {
+        Cell {
+            lo: 0,
+            hi: len as u32,
+            offset: [0.0; 3],
+        }
+    }
+
+    /// The far child of a split on `axis`: beyond the split plane, so at least |diff| away
+    /// along that axis, and no nearer than its parent along the others.
+    #[inline]
+    fn far(split: &Split, axis: u8, mut offset: [f32; 3]) -> Cell {
+        offset[axis as usize] = split.diff.abs();
+        Cell {
+            lo: split.far.0 as u32,
+            hi: split.far.1 as u32,
+            offset,
+        }
+    }
+
+    /// A lower bound on the squared distance from the query to any point in the cell,
+    /// summed in `distance_squared`'s order.
+    #[inline]
+    fn bound(&self) -> f32 {
+        let [x, y, z] = self.offset;
+        x * x + y * y + z * z
     }
 }
 
