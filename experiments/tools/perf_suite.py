@@ -1,0 +1,292 @@
+"""The performance suite: every estimator's samples per second on scenes that cover what a
+renderer's common path must be fast at, and `pt` against Mitsuba 3 side by side.
+
+    python3 experiments/tools/perf_suite.py [--repeats 3] [--only envmap,water]
+        [--mitsuba /work/venv-mitsuba/bin/python] [--out results/perf]
+
+Each scene renders with `mltbench render` (2 threads, its own resolution and max_depth), once
+per estimator and repeat; the table gives the median of the summary line's samples per second
+(pt, bdpt: camera samples; lt: light paths; pssmlt, mmlt: mutations, bootstrap included;
+ppm: light paths of the photon passes). With --mitsuba (a Python that has the `mitsuba`
+package: CROSSCHECK.md), `pt` is also timed against Mitsuba 3's llvm_ad_rgb by
+crosscheck_mitsuba.py, --repeats back-to-back pairs per scene (Mitsuba's JIT warm-up
+excluded), and the table gives the median ratio of camera paths per second. Writes
+OUT/README.md and OUT/perf.csv. The meshes two scenes need are written on first use
+(experiments/perf/meshes/, not committed: one has 330k triangles).
+
+Needs only the standard library (and a built `target/release/mltbench`).
+"""
+
+import argparse
+import csv
+import math
+import statistics
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from crosscheck_mitsuba import MLTBENCH_LINE  # noqa: E402  (the render summary's format)
+
+REPO = Path(__file__).resolve().parents[2]
+BINARY = REPO / "target" / "release" / "mltbench"
+MESHES = REPO / "experiments" / "perf" / "meshes"
+
+# (name, scene file, what it covers)
+SUITE = [
+    ("cbox", "experiments/scenes/cbox.xml", "diffuse, one area light, 36 triangles"),
+    ("cbox-spheres", "experiments/scenes/cbox-spheres.xml", "mirror and glass analytic spheres"),
+    ("cbox-glossy", "experiments/perf/cbox-glossy.xml", "rough conductor, rough plastic, twosided walls"),
+    ("envmap", "experiments/scenes/envmap-spheres.xml", "lat-long environment map, three spheres"),
+    ("water", "experiments/perf/water.xml", "4050-triangle dielectric mesh, textured floor"),
+    ("displaced", "experiments/perf/displaced-sphere.xml", "330k-triangle mesh in the Cornell box"),
+    ("textures", "experiments/scenes/textures.xml", "bitmap and procedural textures"),
+    ("dof", "experiments/scenes/cbox-dof.xml", "thin-lens camera"),
+    ("point", "experiments/scenes/cbox-point.xml", "point light"),
+]
+
+# (estimator label, mltbench arguments, spp): spp keeps every render to a few seconds.
+ESTIMATORS = [
+    ("pt", ["-e", "pt"], 64),
+    ("lt", ["-e", "lt"], 16),
+    ("bdpt", ["-e", "bdpt"], 8),
+    ("pssmlt", ["-e", "pssmlt", "--set", "base=bdpt"], 8),
+    ("mmlt", ["-e", "mmlt"], 16),
+    ("ppm", ["-e", "ppm"], 16),
+]
+
+
+# ---------------------------------------------------------------- meshes
+
+
+def write_ply(path, vertices, faces):
+    """A binary little-endian PLY of float vertices and triangle faces."""
+    header = (
+        "ply\nformat binary_little_endian 1.0\n"
+        f"element vertex {len(vertices)}\n"
+        "property float x\nproperty float y\nproperty float z\n"
+        f"element face {len(faces)}\n"
+        "property list uchar int vertex_indices\nend_header\n"
+    )
+    body = bytearray()
+    for v in vertices:
+        body += struct.pack("<3f", *v)
+    for f in faces:
+        body += struct.pack("<B3i", 3, *f)
+    tmp = path.with_suffix(".tmp")
+    tmp.write_bytes(header.encode("ascii") + bytes(body))
+    tmp.replace(path)
+
+
+def water_mesh(n=45):
+    """An n x n grid of quads over [-1.5, 1.5]^2 at height 0 with ripples of 2 cm."""
+    vertices = []
+    for j in range(n + 1):
+        for i in range(n + 1):
+            x, z = -1.5 + 3.0 * i / n, -1.5 + 3.0 * j / n
+            y = 0.02 * (math.sin(4.1 * x + 1.3 * z) + math.sin(2.3 * z - 3.7 * x + 0.5))
+            vertices.append((x, y, z))
+    faces = []
+    for j in range(n):
+        for i in range(n):
+            a = j * (n + 1) + i
+            b, c, d = a + 1, a + n + 1, a + n + 2
+            # Counter-clockwise seen from above: the faces' front looks up.
+            faces += [(a, c, b), (b, c, d)]
+    return vertices, faces
+
+
+def displaced_sphere_mesh(rings=288, segments=576):
+    """A unit sphere, displaced radially by two octaves of bumps, as rings x segments quads
+    (one triangle per quad at the poles): 330,624 triangles."""
+    vertices = [(0.0, 1.0, 0.0)]
+    for r in range(1, rings):
+        theta = math.pi * r / rings
+        for s in range(segments):
+            phi = 2 * math.pi * s / segments
+            d = 1 + 0.06 * math.sin(9 * theta) * math.cos(7 * phi) + 0.015 * math.sin(
+                41 * theta + 3 * phi
+            ) * math.sin(37 * phi)
+            vertices.append(
+                (d * math.sin(theta) * math.cos(phi), d * math.cos(theta), d * math.sin(theta) * math.sin(phi))
+            )
+    vertices.append((0.0, -1.0, 0.0))
+    south = len(vertices) - 1
+
+    def ring(r, s):  # vertex index of ring r (1..rings-1), segment s
+        return 1 + (r - 1) * segments + s % segments
+
+    faces = []
+    for s in range(segments):
+        faces.append((0, ring(1, s + 1), ring(1, s)))
+        faces.append((south, ring(rings - 1, s), ring(rings - 1, s + 1)))
+    for r in range(1, rings - 1):
+        for s in range(segments):
+            a, b = ring(r, s), ring(r, s + 1)
+            c, d = ring(r + 1, s), ring(r + 1, s + 1)
+            faces += [(a, b, c), (b, d, c)]
+    return vertices, faces
+
+
+def ensure_meshes():
+    MESHES.mkdir(parents=True, exist_ok=True)
+    for name, make in [("water.ply", water_mesh), ("displaced-sphere.ply", displaced_sphere_mesh)]:
+        path = MESHES / name
+        if not path.exists():
+            print(f"writing {path.relative_to(REPO)}", file=sys.stderr)
+            write_ply(path, *make())
+
+
+# ---------------------------------------------------------------- runs
+
+
+def render_rate(scene, args, spp, threads, tmp):
+    """Samples per second from one `mltbench render`, or an error message."""
+    out = Path(tmp) / "perf.exr"
+    cmd = [str(BINARY), "render", str(REPO / scene), *args, "--spp", str(spp)]
+    cmd += ["--threads", str(threads), "-o", str(out)]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0:
+        lines = proc.stderr.strip().splitlines()
+        return None, (lines[-1] if lines else f"exit code {proc.returncode}")
+    for line in proc.stderr.splitlines():
+        m = MLTBENCH_LINE.match(line)
+        if m:
+            return float(m["msps"]), None
+    return None, "no summary line in mltbench's output"
+
+
+def mitsuba_ratio(python, scene, threads, tmp):
+    """mltbench / Mitsuba llvm_ad_rgb camera paths per second for one back-to-back pair."""
+    table = Path(tmp) / "crosscheck.csv"
+    table.unlink(missing_ok=True)
+    cmd = [python, str(REPO / "experiments/tools/crosscheck_mitsuba.py"), str(REPO / scene)]
+    cmd += ["--spp", "64", "--variant", "llvm_ad_rgb", "--threads", str(threads), "--csv", str(table)]
+    proc = subprocess.run(cmd, capture_output=True, text=True)
+    if proc.returncode != 0 or not table.exists():
+        lines = (proc.stderr or proc.stdout).strip().splitlines()
+        return None, (lines[-1] if lines else f"exit code {proc.returncode}")
+    with table.open() as f:
+        row = next(csv.DictReader(f))
+    return (
+        float(row["throughput_ratio"]),
+        float(row["mltbench_mpaths_s"]),
+        float(row["mitsuba_mpaths_s"]),
+    ), None
+
+
+def main(argv):
+    p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    p.add_argument("--repeats", type=int, default=1, help="renders (and Mitsuba pairs) per cell; medians")
+    p.add_argument("--threads", type=int, default=2)
+    p.add_argument("--only", help="comma-separated scene names of the suite")
+    p.add_argument("--estimators", help="comma-separated estimators (default all)")
+    p.add_argument("--mitsuba", metavar="PYTHON", help="a Python with the mitsuba package")
+    p.add_argument("--out", type=Path, default=REPO / "results" / "perf")
+    args = p.parse_args(argv)
+    if not BINARY.exists():
+        print(f"error: {BINARY} not found: run `cargo build --release` first", file=sys.stderr)
+        return 2
+    scenes = SUITE
+    if args.only:
+        wanted = set(args.only.split(","))
+        unknown = wanted - {s[0] for s in SUITE}
+        if unknown:
+            print(f"error: --only names unknown scenes {sorted(unknown)}; the suite has "
+                  f"{[s[0] for s in SUITE]}", file=sys.stderr)
+            return 2
+        scenes = [s for s in SUITE if s[0] in wanted]
+    estimators = ESTIMATORS
+    if args.estimators:
+        wanted = set(args.estimators.split(","))
+        estimators = [e for e in ESTIMATORS if e[0] in wanted]
+    ensure_meshes()
+    args.out.mkdir(parents=True, exist_ok=True)
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, scene, covers in scenes:
+            row = {"scene": name, "file": scene, "covers": covers}
+            for label, est_args, spp in estimators:
+                rates, error = [], None
+                for _ in range(args.repeats):
+                    rate, error = render_rate(scene, est_args, spp, args.threads, tmp)
+                    if rate is None:
+                        break
+                    rates.append(rate)
+                row[label] = statistics.median(rates) if rates and error is None else None
+                row[label + "_error"] = error
+                print(f"{name:14} {label:8} "
+                      + (f"{row[label]:.3f} M/s" if row[label] is not None else f"error: {error}"),
+                      file=sys.stderr)
+            if args.mitsuba:
+                pairs, error = [], None
+                for _ in range(args.repeats):
+                    pair, error = mitsuba_ratio(args.mitsuba, scene, args.threads, tmp)
+                    if pair is None:
+                        break
+                    pairs.append(pair)
+                if pairs and error is None:
+                    row["mitsuba_ratio"] = statistics.median(p[0] for p in pairs)
+                    row["mitsuba_mpaths"] = statistics.median(p[2] for p in pairs)
+                    row["pt_pair_mpaths"] = statistics.median(p[1] for p in pairs)
+                else:
+                    row["mitsuba_error"] = error
+                print(f"{name:14} mitsuba  " + (f"ratio {row['mitsuba_ratio']:.2f}" if "mitsuba_ratio" in row
+                      else f"error: {error}"), file=sys.stderr)
+            rows.append(row)
+    write_outputs(args, rows, estimators)
+    return 0
+
+
+def write_outputs(args, rows, estimators):
+    labels = [e[0] for e in estimators]
+    with (args.out / "perf.csv").open("w", newline="") as f:
+        fields = ["scene", "file"] + labels + ["mitsuba_mpaths", "pt_pair_mpaths", "mitsuba_ratio"]
+        w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
+        w.writeheader()
+        for r in rows:
+            w.writerow({k: ("" if r.get(k) is None else r.get(k)) for k in fields})
+    units = ", ".join(f"{label} {spp} spp" for label, _, spp in estimators)
+    lines = [
+        "# Performance suite",
+        "",
+        f"`python3 experiments/tools/perf_suite.py --repeats {args.repeats}"
+        + (" --mitsuba PYTHON" if args.mitsuba else "")
+        + f"`, {args.threads} threads, {time.strftime('%Y-%m-%d')}. Millions of samples per second "
+        f"(medians of {args.repeats}; {units}): camera samples for pt and bdpt, light paths for "
+        "lt and ppm, mutations for pssmlt (base=bdpt) and mmlt, their bootstrap included.",
+        "",
+    ]
+    head = "| scene | covers | " + " | ".join(labels)
+    rule = "|---|---|" + "---|" * len(labels)
+    if args.mitsuba:
+        head += " | Mitsuba llvm_ad_rgb | pt / Mitsuba"
+        rule += "---|---|"
+    lines += [head + " |", rule]
+    ratios = []
+    for r in rows:
+        cells = [r["scene"], r["covers"]]
+        cells += [f"{r[k]:.3f}" if r.get(k) is not None else "error" for k in labels]
+        if args.mitsuba:
+            if "mitsuba_ratio" in r:
+                cells += [f"{r['mitsuba_mpaths']:.3f}", f"{r['mitsuba_ratio']:.2f}"]
+                ratios.append(r["mitsuba_ratio"])
+            else:
+                cells += ["error", ""]
+        lines.append("| " + " | ".join(cells) + " |")
+    if ratios:
+        gmean = math.exp(sum(math.log(x) for x in ratios) / len(ratios))
+        lines += ["", f"Geometric mean of pt / Mitsuba over {len(ratios)} scenes: {gmean:.2f}."]
+    errors = [(r["scene"], k, r[k + "_error"]) for r in rows for k in labels if r.get(k + "_error")]
+    errors += [(r["scene"], "mitsuba", r["mitsuba_error"]) for r in rows if r.get("mitsuba_error")]
+    if errors:
+        lines += ["", "Errors:", ""] + [f"- {s}, {k}: {e}" for s, k, e in errors]
+    (args.out / "README.md").write_text("\n".join(lines) + "\n")
+    print(f"wrote {args.out / 'README.md'} and perf.csv", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
