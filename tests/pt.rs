@@ -533,8 +533,8 @@ fn hide_emitters_removes_only_what_camera_rays_find() {
 
 /// `pt` traced sixteen paths at a time in SIMD lanes (`wavefront=true`) and one at a time
 /// (`wavefront=false`): the same image bits and the same counts, on every kind of scene the
-/// lanes treat differently (diffuse surfaces in lanes, other BSDFs and textures one lane at
-/// a time; small scenes cast sixteen rays per test, analytic shapes and trees one ray at a
+/// lanes treat differently (diffuse surfaces in lanes, `twosided` diffuse ones from both
+/// sides, other BSDFs and textures one lane at a time; small scenes cast sixteen rays per test, analytic shapes and trees one ray at a
 /// time; mesh lights sampled in lanes, other lights not; emitters hit, the environment
 /// reached, point lights, thin lenses, sample patterns, every depth rule, `hide_emitters`).
 #[test]
@@ -603,6 +603,31 @@ fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
         vec![],
     ));
     cases.push(("point light".into(), point_light_floor().0, vec![]));
+    // `twosided` diffuse panels, one seen from the front and one from behind, with
+    // different front and back reflectances, lit from both sides.
+    cases.push((
+        "twosided panels".into(),
+        scene(&format!(
+            r#"<scene version="3.0.0">
+                {camera}
+                {enclosure}
+                <shape type="rectangle"><transform name="to_world"><scale value="0.6"/>
+                    <rotate y="1" angle="35"/><translate x="-0.5" z="-2"/></transform>
+                    <bsdf type="twosided">
+                        <bsdf type="diffuse"><rgb name="reflectance" value="0.8, 0.5, 0.2"/></bsdf>
+                        <bsdf type="diffuse"><rgb name="reflectance" value="0.1, 0.6, 0.9"/></bsdf>
+                    </bsdf></shape>
+                <shape type="rectangle"><transform name="to_world"><scale value="0.6"/>
+                    <rotate y="1" angle="150"/><translate x="0.6" z="-2.5"/></transform>
+                    <bsdf type="twosided">
+                        <bsdf type="diffuse"><rgb name="reflectance" value="0.7"/></bsdf>
+                    </bsdf></shape>
+            </scene>"#,
+            camera = camera(),
+            enclosure = enclosure("cube", "0.5", "0.8"),
+        )),
+        vec![],
+    ));
     // 6 cubes (72 triangles): more than a small scene, cast through the tree.
     let cubes: String = (0..6)
         .map(|i| {
@@ -652,4 +677,28 @@ fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
         assert_eq!(lanes.1, one_by_one.1, "{name}: counts");
         assert!(lanes.0 == one_by_one.0, "{name}: image bits differ");
     }
+}
+
+/// On a scene whose vertices the lanes mostly hand to the scalar code (textures on every
+/// surface), `pt` with `wavefront=true` leaves the lanes after its first batches and goes
+/// on one path at a time: the image keeps the scalar image's bits across the switch.
+#[test]
+fn leaving_the_lanes_part_way_keeps_the_image_bits() {
+    let scene = shipped_scene("textures.xml", 64);
+    let run = |wavefront: &str| {
+        let params = Params::parse(&[wavefront]).unwrap();
+        let mut e = estimator::create("pt", &params, &scene, 5).unwrap();
+        // 64 × 64 × 32 samples: past the 2^16 vertices after which the lanes' share decides.
+        let out = render(&scene, e.as_mut(), Budget::Passes(32), |_, _| {});
+        let bits: Vec<u32> = out
+            .image
+            .pixels
+            .iter()
+            .flat_map(|p| p.0.map(f32::to_bits))
+            .collect();
+        (bits, out.stats)
+    };
+    let (lanes, one_by_one) = (run("wavefront=true"), run("wavefront=false"));
+    assert_eq!(lanes.1, one_by_one.1, "counts");
+    assert!(lanes.0 == one_by_one.0, "image bits differ");
 }

@@ -158,19 +158,39 @@ impl PathSample {
     ) -> Mask16 {
         let zero = F32x16::splat(0.0);
         let zero3 = V3::new(zero, zero, zero);
-        let rho = V3::new(
-            F32x16::gather(&tables.reflectance[0], hits.shape, m),
-            F32x16::gather(&tables.reflectance[1], hits.shape, m),
-            F32x16::gather(&tables.reflectance[2], hits.shape, m),
-        );
         let frame = LaneFrame::from_normal(hits.ns);
-        let wo = frame.to_local(-lanes.direction.normalize());
+        let mut wo = frame.to_local(-lanes.direction.normalize());
+        // `TwoSided` seen from behind: the back side's reflectance, both directions
+        // mirrored through the surface (a negated z, exact: the scalar code's bits).
+        let two_sided = U32x16::gather(&tables.two_sided, hits.shape, m).eq(U32x16::splat(1));
+        let back = m & two_sided & wo.z.lt(zero);
+        let side = |table: &[Vec<f32>; 3], c: usize| F32x16::gather(&table[c], hits.shape, m);
+        let rho = V3::new(
+            F32x16::select(
+                back,
+                side(&tables.back_reflectance, 0),
+                side(&tables.reflectance, 0),
+            ),
+            F32x16::select(
+                back,
+                side(&tables.back_reflectance, 1),
+                side(&tables.reflectance, 1),
+            ),
+            F32x16::select(
+                back,
+                side(&tables.back_reflectance, 2),
+                side(&tables.reflectance, 2),
+            ),
+        );
+        let mirror = |z: F32x16| F32x16::select(back, -z, z);
+        wo.z = mirror(wo.z);
 
         // Next-event estimation (`sample_light`).
         let u_light = lanes.streams.next_1d(m);
         let u = lanes.streams.next_2d(m);
         let ls = NeeLanes::sample(scene, &hits.p, u_light, u, m);
-        let wi = frame.to_local(ls.wi);
+        let mut wi = frame.to_local(ls.wi);
+        wi.z = mirror(wi.z);
         let inv_pi = F32x16::splat(INV_PI);
         // Diffuse::eval: R/π where both directions are above the surface, black elsewhere.
         let above = wo.z.gt(zero) & wi.z.gt(zero);
@@ -232,8 +252,9 @@ impl PathSample {
         let _u_lobe = lanes.streams.next_1d(m);
         let (ux, uy) = lanes.streams.next_2d(m);
         let u_roulette = lanes.streams.next_1d(m);
-        let wi = cosine_hemisphere(ux, uy);
+        let mut wi = cosine_hemisphere(ux, uy);
         let pdf = F32x16::select(wi.z.gt(zero), wi.z * inv_pi, zero);
+        wi.z = mirror(wi.z);
         let sampled = m & !wo.z.le(zero) & !pdf.le(zero);
         let mut ends = m & !sampled;
         let c = sampled;

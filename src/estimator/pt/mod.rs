@@ -25,6 +25,7 @@ use super::Params;
 mod diffuse_lanes;
 mod hit_lanes;
 mod lane_scene;
+mod lane_share;
 mod path_lanes;
 mod shadow_queue;
 mod wavefront;
@@ -54,7 +55,8 @@ pub struct PtSettings {
     pub path: PathSettings,
     /// Trace sixteen paths at a time in SIMD lanes (`wavefront.rs`; the same image bits as
     /// one at a time, faster where the lanes are AVX-512 registers). The default is on
-    /// where they are (`lanes::NATIVE`), off elsewhere.
+    /// where they are (`lanes::NATIVE`), off elsewhere. On a scene whose vertices the lanes
+    /// mostly leave to the scalar code, batches go one path at a time (`lane_share.rs`).
     pub wavefront: bool,
 }
 
@@ -83,6 +85,7 @@ pub fn new(scene: &Scene, seed: u64, settings: PtSettings) -> Result<PathTracer>
         PathSample {
             settings,
             lane_scene,
+            lane_share: Default::default(),
         },
     )
 }
@@ -92,6 +95,8 @@ pub struct PathSample {
     settings: PtSettings,
     /// The scene's tables for the wavefront (with `settings.wavefront`).
     lane_scene: Option<lane_scene::LaneScene>,
+    /// The share of vertices the lanes leave to the scalar code, so far.
+    lane_share: lane_share::LaneShare,
 }
 
 impl PathSample {
@@ -104,6 +109,7 @@ impl PathSample {
                 wavefront: false,
             },
             lane_scene: None,
+            lane_share: Default::default(),
         }
     }
 }
@@ -328,7 +334,7 @@ impl CameraSampleFn for PathSample {
     }
 
     fn render_tiles(&self, ctx: &PassContext, rects: &[PixelRect]) -> Vec<FinishedTile<()>> {
-        if self.settings.wavefront {
+        if self.settings.wavefront && self.lane_share.lanes_pay() {
             self.render_tiles_in_lanes(ctx, rects)
         } else {
             render_tiles_one_by_one(ctx, rects, self)

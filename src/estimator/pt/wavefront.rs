@@ -21,6 +21,7 @@ use super::PathState;
 use super::diffuse_lanes::power_heuristic_lanes;
 use super::hit_lanes::HitLanes;
 use super::lane_scene::NO_LIGHT;
+use super::lane_share::Coverage;
 use super::path_lanes::PathLanes;
 use super::shadow_queue::ShadowQueue;
 use crate::camera::raster_in_pixel_lanes;
@@ -117,6 +118,7 @@ impl PathSample {
         let mut hits = HitLanes::default();
         let mut next = 0usize;
         let mut sampler = pass.camera_sampler();
+        let mut coverage = Coverage::default();
         // Camera samples start in lanes where they can: independent pixel (and lens)
         // samples, paths of at least one segment.
         let start_in_lanes =
@@ -145,9 +147,10 @@ impl PathSample {
             if lanes.live.none() {
                 break;
             }
-            self.advance_lanes(pass, &mut lanes, &mut hits, queue, shadows);
+            self.advance_lanes(pass, &mut lanes, &mut hits, queue, shadows, &mut coverage);
         }
         shadows.flush(&pass.scene.geometry, queue);
+        self.lane_share.add(coverage);
     }
 
     /// Empty lanes take the next camera samples of `queue` (from index `next`), started in
@@ -293,8 +296,10 @@ impl PathSample {
         hits: &mut HitLanes,
         queue: &mut [QueuedSample],
         shadows: &mut ShadowQueue,
+        coverage: &mut Coverage,
     ) {
         let scene = pass.scene;
+        coverage.vertices += lanes.live.count() as u64;
         let tables = self
             .lane_scene
             .as_ref()
@@ -321,6 +326,7 @@ impl PathSample {
         } else {
             escaped & lanes.shows_environment
         };
+        coverage.scalar += (sees_environment | scalar_emitters).count() as u64;
         for lane in (sees_environment | scalar_emitters).lanes() {
             let mut state = self.take_path(scene, lanes, lane, queue, shadows);
             if !self.arrive(scene, &mut state, hits.interaction(scene, lane).as_ref()) {
@@ -336,6 +342,7 @@ impl PathSample {
         let diffuse = going & U32x16::gather(&tables.diffuse, hits.shape, going).eq(one);
         ended |= self.scatter_diffuse(scene, tables, lanes, hits, diffuse, shadows);
         shadows.cast_full(&scene.geometry, queue);
+        coverage.scalar += (going & !diffuse).count() as u64;
         for lane in (going & !diffuse).lanes() {
             let mut state = self.take_path(scene, lanes, lane, queue, shadows);
             let mut sampler = IndependentSampler::with_state(0, lanes.streams.lane(lane));
