@@ -45,6 +45,9 @@ pub struct Distribution1D {
     sum: f64,
     /// pmf[i] = func[i] / sum, rounded once to f32 (looked up by every light sample).
     pmf: Vec<f32>,
+    /// For more than `SMALL` items, a guide table (Chen and Asau 1974): guide[g] is the
+    /// number of cdf entries ≤ g / n, where a search for u in [g/n, (g+1)/n) starts.
+    guide: Vec<u32>,
 }
 
 impl Distribution1D {
@@ -67,11 +70,27 @@ impl Distribution1D {
             *c /= acc;
         }
         cdf[weights.len()] = 1.0;
+        let n = weights.len();
+        let guide = if n > SMALL {
+            let mut count = 0usize;
+            (0..n)
+                .map(|g| {
+                    let at = g as f64 / n as f64;
+                    while count < cdf.len() && cdf[count] <= at {
+                        count += 1;
+                    }
+                    count as u32
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         Some(Distribution1D {
             func: weights.to_vec(),
             cdf,
             sum: acc,
             pmf: weights.iter().map(|&w| (w as f64 / acc) as f32).collect(),
+            guide,
         })
     }
 
@@ -109,7 +128,19 @@ impl Distribution1D {
         let i = if n <= SMALL {
             self.cdf.iter().map(|&c| (c <= u) as usize).sum()
         } else {
-            self.cdf.partition_point(|&c| c <= u)
+            // The count of entries ≤ u, walked to from the guide's start for u's bucket:
+            // exact whatever the rounding of the bucket's index, and a step or two on
+            // average (a binary search over an environment map's rows and columns was
+            // 6% of `pt`'s time there).
+            let bucket = ((u * n as f64) as usize).min(n - 1);
+            let mut i = self.guide[bucket] as usize;
+            while i > 0 && self.cdf[i - 1] > u {
+                i -= 1;
+            }
+            while i < self.cdf.len() && self.cdf[i] <= u {
+                i += 1;
+            }
+            i
         };
         i.saturating_sub(1).min(n - 1)
     }
@@ -421,6 +452,37 @@ mod tests {
                     pmf > 0.0 && weights[i] > 0.0,
                     "n {n}, u {u}: item {i} of weight 0"
                 );
+            }
+        }
+    }
+
+    #[test]
+    fn the_guide_table_finds_what_a_binary_search_finds() {
+        // Skewed weights (one heavy item, runs of zeros) so that buckets hold many items
+        // or none; u at every cdf entry, just below and above it, and in between.
+        for n in [SMALL + 1, 64, 1000] {
+            let weights: Vec<f32> = (0..n)
+                .map(|k| match k % 9 {
+                    0 | 1 | 2 => 0.0,
+                    3 => 1e-6,
+                    _ if k == n / 3 => 1e4,
+                    _ => (k % 7) as f32 + 0.5,
+                })
+                .collect();
+            let d = Distribution1D::new(&weights).unwrap();
+            let mut us: Vec<f64> = d
+                .cdf
+                .iter()
+                .flat_map(|&c| [c.next_down(), c, c.next_up()])
+                .collect();
+            us.extend((0..=4000).map(|j| j as f64 / 4000.0));
+            for u in us.into_iter().filter(|u| (0.0..1.0).contains(u)) {
+                let expected = d
+                    .cdf
+                    .partition_point(|&c| c <= u)
+                    .saturating_sub(1)
+                    .min(n - 1);
+                assert_eq!(d.find(u), expected, "n {n}, u {u}");
             }
         }
     }
