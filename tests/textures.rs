@@ -452,3 +452,32 @@ fn a_textured_plastic_matches_the_constant_plastic_of_each_cell() {
         }
     }
 }
+
+/// Analytic shapes compute (u, v) only where a texture reads them: a textured sphere's hit
+/// carries Mitsuba's (φ/2π, θ/π), an untextured one's (0, 0).
+#[test]
+fn only_textured_analytic_shapes_compute_uv() {
+    let dir = scratch("textures_uv");
+    let text = scene(
+        r#"<shape type="sphere"><point name="center" x="-3" y="0" z="0"/>
+            <bsdf type="diffuse"><texture type="checkerboard" name="reflectance"/></bsdf></shape>
+        <shape type="sphere"><point name="center" x="3" y="0" z="0"/>
+            <bsdf type="diffuse"/></shape>"#,
+    );
+    let scene = Scene::build(load_written(&dir, &text).unwrap()).unwrap();
+    // Both rays meet their sphere where the normal is (0.5, 0.5, √0.5): φ = 45°, θ = 45°.
+    let uv_at = |x: f32| {
+        let ray = mltbench::geometry::Ray::new(Vec3::new(x + 0.5, 0.5, 5.0), -Vec3::Z);
+        scene
+            .geometry
+            .intersect(&ray)
+            .expect("the ray meets the sphere")
+            .uv
+    };
+    let textured = uv_at(-3.0);
+    assert!(
+        (textured - Vec2::new(0.125, 0.25)).abs().max_element() < 1e-5,
+        "{textured}"
+    );
+    assert_eq!(uv_at(3.0), Vec2::ZERO);
+}

@@ -19,6 +19,8 @@ pub struct Disk {
     /// Unit normal: the local +z through the inverse transpose, negated by `flip_normals`.
     pub n: Vec3,
     pub shape: u32,
+    /// Whether hits compute (u, v) (as `Sphere::uv`).
+    pub uv: bool,
 }
 
 impl Disk {
@@ -43,6 +45,7 @@ impl Disk {
             to_local64: inv,
             n: if flip_normals { -n } else { n },
             shape,
+            uv: true,
         })
     }
 
@@ -74,15 +77,20 @@ impl Disk {
             + (m.y_axis.truncate() * y as f32).abs()
             + m.w_axis.truncate().abs();
         let p_error = p.abs() * gamma(2) + scale * (2.0f32).powi(-46);
-        let mut v = y.atan2(x) / (2.0 * std::f64::consts::PI);
-        if v < 0.0 {
-            v += 1.0;
-        }
+        let uv = if self.uv {
+            let mut v = y.atan2(x) / (2.0 * std::f64::consts::PI);
+            if v < 0.0 {
+                v += 1.0;
+            }
+            Vec2::new(x.hypot(y) as f32, v as f32)
+        } else {
+            Vec2::ZERO
+        };
         AnalyticHit {
             p,
             p_error,
             n: self.n,
-            uv: Vec2::new(x.hypot(y) as f32, v as f32),
+            uv,
         }
     }
 

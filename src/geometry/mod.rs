@@ -304,6 +304,18 @@ impl Geometry {
     /// that cannot be intersected (index out of range, non-finite vertex, zero area) and
     /// analytic shapes with invalid parameters are skipped (counted, see `skipped()`):
     /// the scene loader reports such input; here it must simply not break the tracer.
+    /// Analytic shapes compute (u, v) at their hits only where `needs_uv(shape)` (a
+    /// textured BSDF reads them); elsewhere their hits carry (0, 0), which saves two
+    /// inverse trigonometric calls a hit (triangles interpolate theirs, at no such cost).
+    pub fn keep_uv_only_for(&mut self, needs_uv: impl Fn(u32) -> bool) {
+        for s in &mut self.spheres {
+            s.uv = needs_uv(s.shape);
+        }
+        for d in &mut self.disks {
+            d.uv = needs_uv(d.shape);
+        }
+    }
+
     pub fn build(shapes: &[ShapeDesc]) -> Geometry {
         let mut ids: Vec<[u32; 2]> = Vec::new();
         let mut spheres = Vec::new();
@@ -327,6 +339,7 @@ impl Geometry {
                         radius: *radius,
                         flip_normals: shape.flip_normals,
                         shape: si,
+                        uv: true,
                     };
                     if s.is_valid() {
                         let (lo, hi) = s.bounds();

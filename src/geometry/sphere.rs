@@ -16,6 +16,9 @@ pub struct Sphere {
     pub radius: f32,
     pub flip_normals: bool,
     pub shape: u32,
+    /// Whether hits compute (u, v) (two inverse trigonometric calls): only a textured
+    /// BSDF reads them (`Geometry::keep_uv_only_for`); zero otherwise.
+    pub uv: bool,
 }
 
 impl Sphere {
@@ -76,15 +79,19 @@ impl Sphere {
         let p = p64.as_vec3();
         let p_error = p.abs() * gamma(2)
             + (self.center.abs() + Vec3::splat(self.radius)) * (2.0f32).powi(-46);
-        let mut phi = n.y.atan2(n.x);
-        if phi < 0.0 {
-            phi += 2.0 * std::f64::consts::PI;
-        }
-        let theta = (n.x.hypot(n.y)).atan2(n.z);
-        let uv = Vec2::new(
-            (phi / (2.0 * std::f64::consts::PI)) as f32,
-            (theta / std::f64::consts::PI) as f32,
-        );
+        let uv = if self.uv {
+            let mut phi = n.y.atan2(n.x);
+            if phi < 0.0 {
+                phi += 2.0 * std::f64::consts::PI;
+            }
+            let theta = (n.x.hypot(n.y)).atan2(n.z);
+            Vec2::new(
+                (phi / (2.0 * std::f64::consts::PI)) as f32,
+                (theta / std::f64::consts::PI) as f32,
+            )
+        } else {
+            Vec2::ZERO
+        };
         let n = n.as_vec3().normalize();
         AnalyticHit {
             p,
@@ -111,6 +118,7 @@ mod tests {
     fn tiny_far_sphere_is_hit_accurately() {
         // b² − 4ac would lose every digit here in f32, and most in f64.
         let s = Sphere {
+            uv: true,
             center: Vec3::new(1e5, 2e5, -3e4),
             radius: 1e-2,
             flip_normals: false,
@@ -130,6 +138,7 @@ mod tests {
     #[test]
     fn inside_hits_far_side() {
         let s = Sphere {
+            uv: true,
             center: Vec3::ZERO,
             radius: 2.0,
             flip_normals: true,

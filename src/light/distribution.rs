@@ -463,7 +463,7 @@ mod tests {
         for n in [SMALL + 1, 64, 1000] {
             let weights: Vec<f32> = (0..n)
                 .map(|k| match k % 9 {
-                    0 | 1 | 2 => 0.0,
+                    0..=2 => 0.0,
                     3 => 1e-6,
                     _ if k == n / 3 => 1e4,
                     _ => (k % 7) as f32 + 0.5,

@@ -41,12 +41,14 @@ impl Scene {
     pub fn build(description: SceneDescription) -> Result<Scene> {
         let lights = LightSet::build(&description)?;
         let bsdfs = description.bsdfs.iter().map(Bsdf::from_desc).collect();
-        let textured = description
+        let textured: Vec<bool> = description
             .bsdfs
             .iter()
             .map(BsdfDesc::is_textured)
             .collect();
-        let geometry = Geometry::build(&description.shapes);
+        let mut geometry = Geometry::build(&description.shapes);
+        // Only textures read (u, v) (area emitters' radiance is a constant).
+        geometry.keep_uv_only_for(|shape| textured[description.shapes[shape as usize].bsdf]);
         let camera = Camera::new(&description.sensor);
         Ok(Scene {
             description,
