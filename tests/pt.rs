@@ -16,7 +16,7 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 use mltbench::camera::raster_in_pixel;
-use mltbench::estimator::{self, Params};
+use mltbench::estimator::{self, Params, Stats};
 use mltbench::image::Image;
 use mltbench::math::Rgb;
 use mltbench::render::{Budget, render};
@@ -531,6 +531,20 @@ fn hide_emitters_removes_only_what_camera_rays_find() {
     }
 }
 
+/// `pt`'s image bits and counts after `passes` passes with `params`.
+fn pt_bits(scene: &Scene, params: &[&str], passes: u32, seed: u64) -> (Vec<u32>, Stats) {
+    let params = Params::parse(params).unwrap();
+    let mut e = estimator::create("pt", &params, scene, seed).unwrap();
+    let out = render(scene, e.as_mut(), Budget::Passes(passes), |_, _| {});
+    let bits = out
+        .image
+        .pixels
+        .iter()
+        .flat_map(|p| p.0.map(f32::to_bits))
+        .collect();
+    (bits, out.stats)
+}
+
 /// `pt` traced sixteen paths at a time in SIMD lanes (`wavefront=true`) and one at a time
 /// (`wavefront=false`): the same image bits and the same counts, on every kind of scene the
 /// lanes treat differently (diffuse surfaces in lanes, `twosided` diffuse ones from both
@@ -658,16 +672,7 @@ fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
         let run = |wavefront: &str| {
             let mut all = params.clone();
             all.push(wavefront);
-            let params = Params::parse(&all).unwrap();
-            let mut e = estimator::create("pt", &params, scene, 9).unwrap();
-            let out = render(scene, e.as_mut(), Budget::Passes(4), |_, _| {});
-            let bits: Vec<u32> = out
-                .image
-                .pixels
-                .iter()
-                .flat_map(|p| p.0.map(f32::to_bits))
-                .collect();
-            (bits, out.stats)
+            pt_bits(scene, &all, 4, 9)
         };
         let (lanes, one_by_one) = (run("wavefront=true"), run("wavefront=false"));
         assert!(
@@ -685,19 +690,8 @@ fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
 #[test]
 fn leaving_the_lanes_part_way_keeps_the_image_bits() {
     let scene = shipped_scene("textures.xml", 64);
-    let run = |wavefront: &str| {
-        let params = Params::parse(&[wavefront]).unwrap();
-        let mut e = estimator::create("pt", &params, &scene, 5).unwrap();
-        // 64 × 64 × 32 samples: past the 2^16 vertices after which the lanes' share decides.
-        let out = render(&scene, e.as_mut(), Budget::Passes(32), |_, _| {});
-        let bits: Vec<u32> = out
-            .image
-            .pixels
-            .iter()
-            .flat_map(|p| p.0.map(f32::to_bits))
-            .collect();
-        (bits, out.stats)
-    };
+    // 64 × 64 × 32 samples: past the 2^16 vertices after which the lanes' share decides.
+    let run = |wavefront: &str| pt_bits(&scene, &[wavefront], 32, 5);
     let (lanes, one_by_one) = (run("wavefront=true"), run("wavefront=false"));
     assert_eq!(lanes.1, one_by_one.1, "counts");
     assert!(lanes.0 == one_by_one.0, "image bits differ");

@@ -162,26 +162,22 @@ impl PathSample {
         let mut wo = frame.to_local(-lanes.direction.normalize());
         // `TwoSided` seen from behind: the back side's reflectance, both directions
         // mirrored through the surface (a negated z, exact: the scalar code's bits).
-        let two_sided = U32x16::gather(&tables.two_sided, hits.shape, m).eq(U32x16::splat(1));
-        let back = m & two_sided & wo.z.lt(zero);
-        let side = |table: &[Vec<f32>; 3], c: usize| F32x16::gather(&table[c], hits.shape, m);
-        let rho = V3::new(
-            F32x16::select(
-                back,
-                side(&tables.back_reflectance, 0),
-                side(&tables.reflectance, 0),
-            ),
-            F32x16::select(
-                back,
-                side(&tables.back_reflectance, 1),
-                side(&tables.reflectance, 1),
-            ),
-            F32x16::select(
-                back,
-                side(&tables.back_reflectance, 2),
-                side(&tables.reflectance, 2),
-            ),
-        );
+        let back = if tables.any_two_sided {
+            let two_sided = U32x16::gather(&tables.two_sided, hits.shape, m);
+            m & two_sided.eq(U32x16::splat(1)) & wo.z.lt(zero)
+        } else {
+            Mask16::NONE
+        };
+        let channel = |c: usize| {
+            let front = F32x16::gather(&tables.reflectance[c], hits.shape, m);
+            if back.none() {
+                front
+            } else {
+                let back_side = F32x16::gather(&tables.back_reflectance[c], hits.shape, m);
+                F32x16::select(back, back_side, front)
+            }
+        };
+        let rho = V3::new(channel(0), channel(1), channel(2));
         let mirror = |z: F32x16| F32x16::select(back, -z, z);
         wo.z = mirror(wo.z);
 

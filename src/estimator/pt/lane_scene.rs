@@ -16,6 +16,8 @@ pub(super) struct LaneScene {
     /// 1 where the BSDF is `twosided`: from behind, the back reflectance with both
     /// directions mirrored through the surface (`TwoSided`).
     pub two_sided: Vec<u32>,
+    /// Whether any shape is `two_sided` (else the lanes skip the back side's lookups).
+    pub any_two_sided: bool,
     /// The front diffuse reflectance's channels (0 for other shapes).
     pub reflectance: [Vec<f32>; 3],
     /// The back's channels (the front's for a one-sided `diffuse`).
@@ -63,6 +65,7 @@ impl LaneScene {
         }
         LaneScene {
             diffuse,
+            any_two_sided: two_sided.contains(&1),
             two_sided,
             reflectance,
             back_reflectance,
