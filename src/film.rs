@@ -567,6 +567,19 @@ impl Film {
         target: impl for<'f> Fn(&'f mut Film, usize) -> [&'f mut f64; 3],
     ) {
         let (x, y) = (raster.x as f64, raster.y as f64);
+        let v = value.0.map(f64::from);
+        if let ReconstructionFilter::Box = self.filter {
+            // The one pixel the sample falls in, weight 1 (what the general loop below
+            // computes, without its weight tables: Metropolis merges splats on one thread).
+            let (i, j) = (x.floor() as i64, y.floor() as i64);
+            if (0..self.width as i64).contains(&i) && (0..self.height as i64).contains(&j) {
+                let p = j as usize * self.width as usize + i as usize;
+                for (s, v) in target(self, p).into_iter().zip(v) {
+                    *s += v;
+                }
+            }
+            return;
+        }
         let Some((x0, x1)) = clip(self.filter.footprint(x), 0, self.width as i64) else {
             return;
         };
@@ -575,7 +588,6 @@ impl Film {
         };
         weights_1d(&self.filter, x, x0, x1, &mut self.scratch_x);
         weights_1d(&self.filter, y, y0, y1, &mut self.scratch_y);
-        let v = value.0.map(f64::from);
         for j in y0..=y1 {
             let wy = self.scratch_y[(j - y0) as usize];
             let row = j as usize * self.width as usize;

@@ -292,7 +292,13 @@ fn splats_add_with_the_scale() {
     film.splat(Vec2::new(2.1, 1.9), Rgb::new(0.5, 1.0, 2.0));
     film.splat(Vec2::new(0.5, 3.5), Rgb::new(8.0, 0.0, 0.0));
     film.splat(Vec2::new(-0.5, 3.5), Rgb::new(8.0, 0.0, 0.0)); // outside: dropped
+    // On a pixel's top-left corner: that pixel; on the image's right edge: dropped.
+    film.splat(Vec2::new(4.0, 2.0), Rgb::new(4.0, 4.0, 4.0));
+    film.splat(Vec2::new(6.0, 2.5), Rgb::new(4.0, 4.0, 4.0));
     let image = film.image(0.25);
+    assert_eq!(image.get(4, 2), Rgb::splat(1.0));
+    assert_eq!(image.get(3, 1), Rgb::BLACK);
+    assert_eq!(image.get(5, 2), Rgb::BLACK);
     // Pixel (2, 1): mean of the samples (2) + 0.25 · (1, 2, 4).
     assert_eq!(image.get(2, 1), Rgb::new(2.25, 2.5, 3.0));
     assert_eq!(image.get(0, 3), Rgb::new(2.0, 0.0, 0.0));

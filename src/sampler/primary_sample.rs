@@ -80,7 +80,10 @@ impl SmallStep {
                     } else {
                         (-1.0, 2.0 * u - 1.0)
                     };
-                    v = wrap(v + sign * s2 * (-self.log_ratio * u).exp());
+                    // The size in f32 (the coordinate is read as f32): expf is the cheaper
+                    // exponential, and any size distribution keeps the step symmetric.
+                    let size = ((-self.log_ratio * u) as f32).exp() as f64;
+                    v = wrap(v + sign * s2 * size);
                 }
                 v
             }

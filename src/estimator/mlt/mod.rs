@@ -59,7 +59,13 @@ pub struct Metropolis<T: PathTarget> {
     settings: ChainSettings,
     target: T,
     seed: u64,
+    /// Every pass merged except the last.
     film: Film,
+    /// The last pass's splats, one list per chain, merged into `film` while the chains take
+    /// the next pass (and by `image`).
+    pending: Vec<SplatList>,
+    /// The lists the chains fill in the current pass.
+    fresh: Vec<SplatList>,
     chains: Vec<Chain>,
     /// What the bootstrap found (None before the first pass).
     bootstrap: Option<Bootstrap>,
@@ -147,6 +153,14 @@ fn check_lights(scene: &Scene, name: &str) -> Result<()> {
     Ok(())
 }
 
+/// Adds `lists` to `film` in order and empties them.
+fn merge(film: &mut Film, lists: &mut [SplatList]) {
+    for list in lists {
+        film.merge_splats(list);
+        list.clear();
+    }
+}
+
 /// Mutations chain `k` of `chains` takes in one pass of `pixels` mutations.
 fn share(pixels: u64, chains: u64, k: u64) -> u64 {
     pixels / chains + u64::from(k < pixels % chains)
@@ -174,6 +188,8 @@ impl<T: PathTarget> Metropolis<T> {
             target,
             seed,
             film,
+            pending: Vec::new(),
+            fresh: Vec::new(),
             chains: Vec::new(),
             bootstrap: None,
             stats: Stats::default(),
@@ -324,32 +340,38 @@ impl<T: PathTarget> Estimator for Metropolis<T> {
         let n_chains = self.chains.len() as u64;
         let settings = self.settings;
         let b = self.bootstrap.as_ref().map_or(0.0, |s| s.b);
-        let target = &self.target;
-        // Each chain's splats, pass by pass.
-        let splats: Vec<Vec<SplatList>> = self
-            .chains
-            .par_iter_mut()
-            .enumerate()
-            .map(|(k, chain)| {
-                let mut scratch = T::Scratch::default();
-                (0..count)
-                    .map(|_| {
-                        let mut list = SplatList::new();
-                        for _ in 0..share(pixels, n_chains, k as u64) {
-                            chain.step(&settings, b, &mut list, |sampler, out| {
-                                let e = target.evaluate(scene, sampler, None, &mut scratch, out);
-                                (e.rays, e.invalid)
-                            });
-                        }
-                        list
-                    })
-                    .collect()
-            })
-            .collect();
-        for pass in 0..count as usize {
-            for chain in &splats {
-                self.film.merge_splats(&chain[pass]);
-            }
+        let Metropolis {
+            target,
+            chains,
+            film,
+            pending,
+            fresh,
+            ..
+        } = self;
+        fresh.resize_with(chains.len(), SplatList::new);
+        for _ in 0..count {
+            // The previous pass's splats go to the film (in chain order) while the chains
+            // take this pass's steps: the merge is serial, and overlapping it keeps the
+            // second thread busy.
+            rayon::join(
+                || merge(film, pending),
+                || {
+                    chains
+                        .par_iter_mut()
+                        .zip(fresh.par_iter_mut())
+                        .enumerate()
+                        .for_each_init(T::Scratch::default, |scratch, (k, (chain, list))| {
+                            list.clear();
+                            for _ in 0..share(pixels, n_chains, k as u64) {
+                                chain.step(&settings, b, list, |sampler, out| {
+                                    let e = target.evaluate(scene, sampler, None, scratch, out);
+                                    (e.rays, e.invalid)
+                                });
+                            }
+                        })
+                },
+            );
+            std::mem::swap(pending, fresh);
         }
         let counts = self.counts();
         self.stats.samples = counts.steps();
@@ -358,7 +380,12 @@ impl<T: PathTarget> Estimator for Metropolis<T> {
     }
 
     fn image(&self) -> Image {
-        self.film.image_with_light_paths(self.stats.samples)
+        if self.pending.iter().all(SplatList::is_empty) {
+            return self.film.image_with_light_paths(self.stats.samples);
+        }
+        let mut film = self.film.clone();
+        merge(&mut film, &mut self.pending.clone());
+        film.image_with_light_paths(self.stats.samples)
     }
 
     fn stats(&self) -> Stats {
