@@ -250,6 +250,18 @@ impl BdptSample {
                 if c.value.is_black() {
                     continue;
                 }
+                if !c.value.is_valid_radiance() {
+                    *invalid += 1;
+                    continue;
+                }
+                // Visibility before the weight: the weight's O(s + t) densities are spent
+                // only on connections that carry light.
+                if let Some(shadow) = &c.shadow {
+                    *rays += 1;
+                    if scene.geometry.occluded(shadow) {
+                        continue;
+                    }
+                }
                 let w = connection::weight(
                     scene,
                     light_path,
@@ -265,15 +277,9 @@ impl BdptSample {
                 if value.is_black() && !every_strategy {
                     continue;
                 }
-                if !c.value.is_valid_radiance() || !value.is_valid_radiance() {
+                if !value.is_valid_radiance() {
                     *invalid += 1;
                     continue;
-                }
-                if let Some(shadow) = &c.shadow {
-                    *rays += 1;
-                    if scene.geometry.occluded(shadow) {
-                        continue;
-                    }
                 }
                 observe(&StrategyEvent {
                     s,

@@ -158,6 +158,13 @@ impl PathTarget for MultiplexedTarget {
         if c.value.is_black() {
             return eval;
         }
+        // Visibility before the weight (whose densities cost O(d)).
+        if let Some(shadow) = &c.shadow {
+            eval.rays += 1;
+            if scene.geometry.occluded(shadow) {
+                return eval;
+            }
+        }
         let w = connection::weight(
             scene,
             light_path,
@@ -169,12 +176,6 @@ impl PathTarget for MultiplexedTarget {
             hide,
             densities,
         );
-        if let Some(shadow) = &c.shadow {
-            eval.rays += 1;
-            if scene.geometry.occluded(shadow) {
-                return eval;
-            }
-        }
         let value = c.value * (w * (strategies as f64 / pick) as f32);
         out.push(c.raster.unwrap_or(raster), value, &mut eval.invalid);
         out.finish();
