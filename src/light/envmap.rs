@@ -24,7 +24,7 @@ use crate::error::{Error, Location, Result};
 use crate::io::exr::read_exr;
 use crate::light::distribution::Distribution2D;
 use crate::light::{EmissionSample, LightSample, SceneSphere};
-use crate::math::{PI, Rgb, Transform};
+use crate::math::{PI, Rgb, Transform, fast_trig};
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct EnvmapLight {
@@ -186,11 +186,21 @@ impl EnvmapLight {
         if d == Vec3::ZERO {
             return Rgb::BLACK;
         }
+        let u = fast_trig::atan2(d.x, -d.z) * (0.5 / PI);
+        let x = (u * self.width as f32 - 0.5).rem_euclid(self.width as f32);
+        self.bilinear(x, self.row_coordinate(d.y))
+    }
+
+    /// The texel row coordinate y = v·(H − 1) of a direction with cos θ = `cos`
+    /// (v = acos(cos θ)/π).
+    fn row_coordinate(&self, cos: f32) -> f32 {
+        fast_trig::acos(cos) / PI * (self.height - 1) as f32
+    }
+
+    /// The bilinear interpolation at texel coordinates (x, y): x in [0, W) from texel
+    /// column 0 (wrapping around), y in [0, H − 1] from row 0.
+    fn bilinear(&self, x: f32, y: f32) -> Rgb {
         let (w, h) = (self.width, self.height);
-        let u = d.x.atan2(-d.z) * (0.5 / PI);
-        let v = d.y.clamp(-1.0, 1.0).acos() / PI;
-        let x = (u * w as f32 - 0.5).rem_euclid(w as f32);
-        let y = v * (h - 1) as f32;
         let i0 = (x as usize).min(w - 1);
         let j0 = (y as usize).min(h - 2);
         let fx = (x - i0 as f32).clamp(0.0, 1.0);
@@ -209,17 +219,38 @@ impl EnvmapLight {
 
     /// A world direction towards the environment with its solid-angle density.
     pub fn sample_direction(&self, u: Vec2) -> Option<(Vec3, f32)> {
+        self.sample_texel_direction(u).map(|s| (s.wi, s.pdf))
+    }
+
+    /// `sample_direction` with the radiance from the sampled direction, read from the
+    /// sample's own texel coordinates (`lookup` of the direction would first recover them).
+    fn sample_with_radiance(&self, u: Vec2) -> Option<(Vec3, f32, Rgb)> {
+        let s = self.sample_texel_direction(u)?;
+        let radiance = self.bilinear(s.x, self.row_coordinate(s.cos));
+        Some((s.wi, s.pdf, radiance))
+    }
+
+    /// A cell by the map's distribution, a direction uniform in solid angle within it.
+    fn sample_texel_direction(&self, u: Vec2) -> Option<TexelDirection> {
         let cells = self.cells.as_ref()?;
         let (uv, _, [iu, iv]) = cells.sample(u);
         let fx = (uv.x * self.width as f32 - iu as f32).clamp(0.0, 1.0);
         let fy = (uv.y * (self.height - 1) as f32 - iv as f32).clamp(0.0, 1.0);
-        let phi = 2.0 * PI * (iu as f32 + fx + 0.5) / self.width as f32;
+        // Texel column coordinate x = u·W − ½ (`lookup`'s), so φ = 2π(x + ½)/W.
+        let x = iu as f32 + fx;
+        let phi = 2.0 * PI * (x + 0.5) / self.width as f32;
         let cos = self.cos_rows[iv] + (self.cos_rows[iv + 1] - self.cos_rows[iv]) * fy;
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
-        let local = Vec3::new(phi.sin() * sin, cos, -phi.cos() * sin);
+        let (sin_phi, cos_phi) = phi.sin_cos();
+        let local = Vec3::new(sin_phi * sin, cos, -cos_phi * sin);
         let wi = (self.to_world * local).normalize();
         let pdf = cells.cell_probability(iu, iv) / self.cell_solid_angle(iv);
-        (pdf > 0.0 && pdf.is_finite() && wi.is_finite()).then_some((wi, pdf))
+        (pdf > 0.0 && pdf.is_finite() && wi.is_finite()).then_some(TexelDirection {
+            wi,
+            pdf,
+            x,
+            cos,
+        })
     }
 
     /// Solid-angle density of `sample_direction` producing world direction `wi`.
@@ -232,7 +263,7 @@ impl EnvmapLight {
             return 0.0;
         }
         let w = self.width;
-        let u = d.x.atan2(-d.z) * (0.5 / PI);
+        let u = fast_trig::atan2(d.x, -d.z) * (0.5 / PI);
         let iu = ((u * w as f32 - 0.5).rem_euclid(w as f32) as usize).min(w - 1);
         // Row band j holds cos θ in [cos_rows[j+1], cos_rows[j]] (cos θ decreasing in j).
         let cos = d.y.clamp(-1.0, 1.0);
@@ -244,14 +275,14 @@ impl EnvmapLight {
     }
 
     pub fn sample_li(&self, u: Vec2) -> Option<LightSample> {
-        let (wi, pdf) = self.sample_direction(u)?;
-        Some(LightSample::at_infinity(wi, self.le(wi), pdf))
+        let (wi, pdf, radiance) = self.sample_with_radiance(u)?;
+        Some(LightSample::at_infinity(wi, radiance, pdf))
     }
 
     /// A direction by the map's distribution, a uniform point of the disk of radius R
     /// perpendicular to it, R before the scene's centre.
     pub fn sample_le(&self, u1: Vec2, u2: Vec2) -> Option<EmissionSample> {
-        let (wi, pdf_dir) = self.sample_direction(u2)?;
+        let (wi, pdf_dir, radiance) = self.sample_with_radiance(u2)?;
         let direction = -wi;
         let (origin, pdf_pos) = self.sphere.sample_disk(direction, u1);
         Some(EmissionSample {
@@ -261,7 +292,7 @@ impl EnvmapLight {
             front: direction,
             p_error: Vec3::ZERO,
             primitive: 0,
-            radiance: self.le(wi),
+            radiance,
             pdf_pos,
             pdf_dir,
             delta_pos: false,
@@ -273,6 +304,15 @@ impl EnvmapLight {
     pub fn pdf_le(&self, dir: Vec3) -> (f32, f32) {
         (self.sphere.disk_pdf(), self.pdf_direction(-dir))
     }
+}
+
+/// A direction `sample_texel_direction` drew: world direction, solid-angle density, and
+/// where it lies on the map (texel column coordinate x, cos θ in the map's frame).
+struct TexelDirection {
+    wi: Vec3,
+    pdf: f32,
+    x: f32,
+    cos: f32,
 }
 
 fn luminance_f64(c: &Rgb) -> f64 {
