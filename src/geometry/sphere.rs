@@ -32,21 +32,22 @@ impl Sphere {
     /// The discriminant is formed from the distance between the centre and the ray's line
     /// rather than from b² − 4ac, which cancels catastrophically for small spheres far from
     /// the origin (Haines, Günther & Akenine-Möller, "Precision Improvements for Ray/Sphere
-    /// Intersection", Ray Tracing Gems, 2019, ch. 7); the roots use the stable quadratic
-    /// formula (no subtraction of nearly equal numbers).
+    /// Intersection", Ray Tracing Gems, 2019, ch. 7): that distance is |f × d|/|d| (f from
+    /// the centre to o), so a·disc = r²·a − |f × d|² needs no division, and a ray that
+    /// misses (most tests) costs no division or square root. The roots use the stable
+    /// quadratic formula (no subtraction of nearly equal numbers).
     pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f64) -> Option<f64> {
         let d = d.as_dvec3();
         let f = o.as_dvec3() - self.center.as_dvec3();
         let r = self.radius as f64;
         let a = d.length_squared();
-        let b = f.dot(d); // half of the usual b
-        let l = f - d * (b / a); // centre to the closest point of the line
-        let disc = r * r - l.length_squared();
-        if disc.is_nan() || disc < 0.0 {
+        let a_disc = r * r * a - f.cross(d).length_squared();
+        if a_disc.is_nan() || a_disc < 0.0 {
             return None;
         }
+        let b = f.dot(d); // half of the usual b
         let c = f.length_squared() - r * r;
-        let q = -(b + (a * disc).sqrt().copysign(b));
+        let q = -(b + a_disc.sqrt().copysign(b));
         let (t0, t1) = if q == 0.0 {
             let t = -b / a;
             (t, t)
