@@ -63,8 +63,8 @@ fn one_and_two_threads_give_bit_identical_images() {
 }
 
 /// Passes run several at a time (`run_passes`, as `render` does in chunks) give the bits of
-/// one pass at a time, for every estimator, with a box and with a Gaussian filter (whose
-/// tiles overlap, so the merge order shows in the bits).
+/// one pass at a time, for every camera-pass and Metropolis estimator, with a box and with
+/// a Gaussian filter (whose tiles overlap, so the merge order shows in the bits).
 #[test]
 fn passes_in_chunks_give_the_bits_of_one_pass_at_a_time() {
     let path = scenes_dir().join("cbox.xml");
@@ -86,6 +86,9 @@ fn passes_in_chunks_give_the_bits_of_one_pass_at_a_time() {
             ("eyelight", vec![]),
             ("lt", vec![]),
             ("bdpt", vec![]),
+            ("pssmlt", vec!["base=pt", "bootstrap=2000", "chains=16"]),
+            ("pssmlt", vec!["base=bdpt", "bootstrap=2000", "chains=16"]),
+            ("mmlt", vec!["bootstrap=2000", "chains=16"]),
         ] {
             let run = |chunks: &[u32]| {
                 let params = Params::parse(&params).unwrap();

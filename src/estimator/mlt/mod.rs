@@ -348,8 +348,10 @@ impl<T: PathTarget> Estimator for Metropolis<T> {
             fresh,
             ..
         } = self;
-        fresh.resize_with(chains.len(), SplatList::new);
         for _ in 0..count {
+            // One list per chain (after a swap `fresh` holds the lists just merged, or none
+            // before the first pass).
+            fresh.resize_with(chains.len(), SplatList::new);
             // The previous pass's splats go to the film (in chain order) while the chains
             // take this pass's steps: the merge is serial, and overlapping it keeps the
             // second thread busy.
