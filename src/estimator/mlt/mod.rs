@@ -13,7 +13,8 @@
 //!   number and their streams do not depend on the thread count. A pass is one mutation
 //!   per pixel, spread evenly over the chains; each chain's splats of each pass merge in
 //!   (pass, chain) order, so images are bit-identical for any `--threads` and for passes
-//!   taken one at a time or in chunks.
+//!   taken one at a time or in chunks. One thread merges a pass's lists while the chains
+//!   take the next pass; the last pass's lists wait for the next call or for `image()`.
 //! * Image = b × (expected-value splats) / mutations per pixel (`chain`).
 //! * `diagnostics` (JSON beside every image): acceptance, b and its standard error, chains
 //!   that never moved, the integrated autocorrelation time of the chains' importance and
