@@ -186,9 +186,14 @@ impl EnvmapLight {
         if d == Vec3::ZERO {
             return Rgb::BLACK;
         }
+        self.bilinear(self.column_coordinate(d), self.row_coordinate(d.y))
+    }
+
+    /// The texel column coordinate x = u·W − ½ in [0, W) of unit local direction `d`
+    /// (u = atan2(d.x, −d.z)/2π, wrapped around).
+    fn column_coordinate(&self, d: Vec3) -> f32 {
         let u = fast_trig::atan2(d.x, -d.z) * (0.5 / PI);
-        let x = (u * self.width as f32 - 0.5).rem_euclid(self.width as f32);
-        self.bilinear(x, self.row_coordinate(d.y))
+        (u * self.width as f32 - 0.5).rem_euclid(self.width as f32)
     }
 
     /// The texel row coordinate y = v·(H − 1) of a direction with cos θ = `cos`
@@ -197,8 +202,8 @@ impl EnvmapLight {
         fast_trig::acos(cos) / PI * (self.height - 1) as f32
     }
 
-    /// The bilinear interpolation at texel coordinates (x, y): x in [0, W) from texel
-    /// column 0 (wrapping around), y in [0, H − 1] from row 0.
+    /// The bilinear interpolation at texel coordinates (x, y): x in [0, W] from texel
+    /// column 0 (wrapping around: W is column 0 again), y in [0, H − 1] from row 0.
     fn bilinear(&self, x: f32, y: f32) -> Rgb {
         let (w, h) = (self.width, self.height);
         let i0 = (x as usize).min(w - 1);
@@ -217,13 +222,9 @@ impl EnvmapLight {
         2.0 * PI / self.width as f32 * (self.cos_rows[j] - self.cos_rows[j + 1])
     }
 
-    /// A world direction towards the environment with its solid-angle density.
-    pub fn sample_direction(&self, u: Vec2) -> Option<(Vec3, f32)> {
-        self.sample_texel_direction(u).map(|s| (s.wi, s.pdf))
-    }
-
-    /// `sample_direction` with the radiance from the sampled direction, read from the
-    /// sample's own texel coordinates (`lookup` of the direction would first recover them).
+    /// A world direction towards the environment, its solid-angle density and the radiance
+    /// from it, read at the sample's own texel coordinates (`lookup` of the direction would
+    /// first recover them).
     fn sample_with_radiance(&self, u: Vec2) -> Option<(Vec3, f32, Rgb)> {
         let s = self.sample_texel_direction(u)?;
         let radiance = self.bilinear(s.x, self.row_coordinate(s.cos));
@@ -253,7 +254,7 @@ impl EnvmapLight {
         })
     }
 
-    /// Solid-angle density of `sample_direction` producing world direction `wi`.
+    /// Solid-angle density of `sample_with_radiance` producing world direction `wi`.
     pub fn pdf_direction(&self, wi: Vec3) -> f32 {
         let Some(cells) = self.cells.as_ref() else {
             return 0.0;
@@ -262,9 +263,7 @@ impl EnvmapLight {
         if d == Vec3::ZERO {
             return 0.0;
         }
-        let w = self.width;
-        let u = fast_trig::atan2(d.x, -d.z) * (0.5 / PI);
-        let iu = ((u * w as f32 - 0.5).rem_euclid(w as f32) as usize).min(w - 1);
+        let iu = (self.column_coordinate(d) as usize).min(self.width - 1);
         // Row band j holds cos θ in [cos_rows[j+1], cos_rows[j]] (cos θ decreasing in j).
         let cos = d.y.clamp(-1.0, 1.0);
         let rows = self.height - 1;
@@ -307,7 +306,8 @@ impl EnvmapLight {
 }
 
 /// A direction `sample_texel_direction` drew: world direction, solid-angle density, and
-/// where it lies on the map (texel column coordinate x, cos θ in the map's frame).
+/// where it lies on the map (texel column coordinate x in [0, W], cos θ in the map's
+/// frame).
 struct TexelDirection {
     wi: Vec3,
     pdf: f32,

@@ -387,7 +387,9 @@ impl<T: PathTarget> Estimator for Metropolis<T> {
             return self.film.image_with_light_paths(self.stats.samples);
         }
         let mut film = self.film.clone();
-        merge(&mut film, &mut self.pending.clone());
+        for list in &self.pending {
+            film.merge_splats(list);
+        }
         film.image_with_light_paths(self.stats.samples)
     }
 
