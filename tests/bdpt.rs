@@ -125,7 +125,12 @@ fn agrees_with_pt_block_by_block_on_every_shipped_scene() {
     // The point light under the ceiling and the spheres' caustics give both estimators
     // heavy-tailed noise (rare bright samples), for which Welch's t over few runs is too
     // quick to reject: there, a coarser film and more runs, so that each block mean sums
-    // enough samples to be near normal.
+    // enough samples to be near normal. Not here: `cbox-spheres-smalllight.xml`, whose
+    // light pt finds through the glass by chance only (a 0.1 × 0.1 light, no next-event
+    // estimation behind a delta bounce): at 64 spp a block's pt mean sits 25% low in all
+    // 32 runs at once (t = 23), and a long pt render agrees with bdpt within its noise;
+    // and `sds.xml`, whose point light's caustic on the floor (light, glass, floor, eye)
+    // only strategies with a light vertex make: pt has none of them.
     for (file, params, res, runs_each, seed) in [
         ("cbox.xml", "mis=balance", 32, 16, 1000),
         ("cbox.xml", "mis=power", 32, 16, 1100),
@@ -139,6 +144,8 @@ fn agrees_with_pt_block_by_block_on_every_shipped_scene() {
         ("sun-room.xml", "mis=balance", 16, 32, 6000),
         ("textures.xml", "mis=balance", 16, 16, 6500),
         ("textures-plastic.xml", "mis=balance", 16, 16, 6700),
+        ("door-ajar.xml", "mis=balance", 16, 32, 7000),
+        ("door-ajar-indirect.xml", "mis=power", 16, 32, 7100),
     ] {
         let scene = shipped_scene(file, res);
         let bdpt = runs("bdpt", &scene, &[params], runs_each, 64, seed);
