@@ -10,7 +10,8 @@ per estimator and repeat; the table gives the median of the summary line's sampl
 ppm: light paths of the photon passes). With --mitsuba (a Python that has the `mitsuba`
 package: CROSSCHECK.md), `pt` is also timed against Mitsuba 3's llvm_ad_rgb by
 crosscheck_mitsuba.py, --repeats back-to-back pairs per scene (Mitsuba's JIT warm-up
-excluded), and the table gives the median ratio of camera paths per second. Writes
+excluded), and the table gives the median ratio of camera paths per second (not for the
+scenes of NO_MITSUBA, which Mitsuba 3 cannot load). Writes
 OUT/README.md and OUT/perf.csv. The meshes two scenes need are written on first use
 (experiments/perf/meshes/, not committed: one has 330k triangles).
 
@@ -46,7 +47,12 @@ SUITE = [
     ("textures", "experiments/scenes/textures.xml", "bitmap and procedural textures"),
     ("dof", "experiments/scenes/cbox-dof.xml", "thin-lens camera"),
     ("point", "experiments/scenes/cbox-point.xml", "point light"),
+    ("smallvcm-cbox", "experiments/perf/smallvcm-cbox.xml",
+     "SmallVCM's point-light box (its -s 2): bdpt against smallvcm -a bpt"),
 ]
+
+# Scenes Mitsuba 3 cannot load, and why: no pt / Mitsuba ratio for them.
+NO_MITSUBA = {"smallvcm-cbox": "Mitsuba 3 has no phong BSDF"}
 
 # (estimator label, mltbench arguments, spp): spp keeps every render to a few seconds.
 ESTIMATORS = [
@@ -221,7 +227,10 @@ def main(argv):
                 print(f"{name:14} {label:8} "
                       + (f"{row[label]:.3f} M/s" if row[label] is not None else f"error: {error}"),
                       file=sys.stderr)
-            if args.mitsuba:
+            if args.mitsuba and name in NO_MITSUBA:
+                row["mitsuba_skipped"] = NO_MITSUBA[name]
+                print(f"{name:14} mitsuba  skipped: {NO_MITSUBA[name]}", file=sys.stderr)
+            elif args.mitsuba:
                 pairs, error = [], None
                 for _ in range(args.repeats):
                     pair, error = mitsuba_ratio(args.mitsuba, scene, args.threads, tmp)
@@ -274,6 +283,8 @@ def write_outputs(args, rows, estimators):
             if "mitsuba_ratio" in r:
                 cells += [f"{r['mitsuba_mpaths']:.3f}", f"{r['mitsuba_ratio']:.2f}"]
                 ratios.append(r["mitsuba_ratio"])
+            elif "mitsuba_skipped" in r:
+                cells += [f"— ({r['mitsuba_skipped']})", ""]
             else:
                 cells += ["error", ""]
         lines.append("| " + " | ".join(cells) + " |")
