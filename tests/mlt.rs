@@ -87,16 +87,28 @@ fn agrees_with_bdpt_on_every_shipped_scene() {
         } else {
             &[]
         };
-        let bdpt = runs("bdpt", &scene, depth, 8, passes, seed);
-        for (k, (name, param)) in METROPOLIS.iter().enumerate() {
-            let mut params = vec![*param];
-            params.extend(SHORT);
-            params.extend(depth);
-            let mlt = runs(name, &scene, &params, 8, passes, seed + 10 * (k as u64 + 1));
-            let what = format!("{file}: {name} {param}");
-            assert_means_agree(&what, &mlt, &bdpt);
-            assert_blocks_agree_of(&what, &mlt, &bdpt, 16);
-        }
+        assert_metropolis_agrees_with_bdpt(file, &scene, depth, passes, seed);
+    }
+}
+
+/// Every Metropolis estimator (with `extra` parameters, which `bdpt` gets too) against
+/// `bdpt` on `scene`, 8 runs each: image means and 16 × 16 blocks.
+fn assert_metropolis_agrees_with_bdpt(
+    file: &str,
+    scene: &Scene,
+    extra: &[&str],
+    passes: u32,
+    seed: u64,
+) {
+    let bdpt = runs("bdpt", scene, extra, 8, passes, seed);
+    for (k, (name, param)) in METROPOLIS.iter().enumerate() {
+        let mut params = vec![*param];
+        params.extend(SHORT);
+        params.extend(extra);
+        let mlt = runs(name, scene, &params, 8, passes, seed + 10 * (k as u64 + 1));
+        let what = format!("{file}: {name} {param}");
+        assert_means_agree(&what, &mlt, &bdpt);
+        assert_blocks_agree_of(&what, &mlt, &bdpt, 16);
     }
 }
 
@@ -112,15 +124,7 @@ fn agrees_with_bdpt_where_light_comes_through_a_gap() {
         ("sds.xml", 32, 32, 1300),
     ] {
         let scene = shipped_scene(file, res);
-        let bdpt = runs("bdpt", &scene, &[], 8, passes, seed);
-        for (k, (name, param)) in METROPOLIS.iter().enumerate() {
-            let mut params = vec![*param];
-            params.extend(SHORT);
-            let mlt = runs(name, &scene, &params, 8, passes, seed + 10 * (k as u64 + 1));
-            let what = format!("{file}: {name} {param}");
-            assert_means_agree(&what, &mlt, &bdpt);
-            assert_blocks_agree_of(&what, &mlt, &bdpt, 16);
-        }
+        assert_metropolis_agrees_with_bdpt(file, &scene, &[], passes, seed);
     }
 }
 
