@@ -863,9 +863,9 @@ fn stream_queries_match_single_ray_queries() {
 }
 
 /// Sixteen rays per query (`closest_hits_lanes`, `surface_lanes`, `occluded_lanes`): each
-/// lane must answer exactly as the per-ray queries do (same surface, same bits), on a small
-/// scene tested sixteen rays per triangle and on scenes answered one ray at a time (a tree,
-/// analytic shapes). The rays include ones aimed exactly at shared vertices (zero edge
+/// lane must answer exactly as the per-ray queries do (same surface, same bits), on small
+/// scenes tested sixteen rays per triangle and sphere (with and without analytic shapes)
+/// and on a scene answered one ray at a time (a tree). The rays include ones aimed exactly at shared vertices (zero edge
 /// functions), rays leaving surfaces (T near its error bound), short segments and rays
 /// that cannot hit anything.
 #[test]
@@ -878,12 +878,23 @@ fn packet_queries_match_single_ray_queries() {
         "rounded",
         cube_sphere(Vec3::new(0.6, 0.3, 0.4), 0.15, 1),
     ));
+    // A small scene with analytic shapes: spheres (two overlapping, one with its normals
+    // flipped, one that some rays start inside) and a disk, tested in f64 lanes.
+    let mut small_analytic = cornell_box(1.0);
+    small_analytic.push(sphere_shape(Vec3::new(0.3, 0.3, 0.3), 0.2, false));
+    small_analytic.push(sphere_shape(Vec3::new(0.42, 0.35, 0.3), 0.15, false));
+    small_analytic.push(sphere_shape(Vec3::new(0.7, 0.35, 0.6), 0.25, true));
+    let disk = Mat4::from_translation(Vec3::new(0.5, 0.85, 0.6))
+        * Mat4::from_rotation_x(0.6)
+        * Mat4::from_scale(Vec3::splat(0.2));
+    small_analytic.push(disk_shape(disk, false));
     for (name, shapes) in [
         ("small", small),
+        ("small and analytic", small_analytic),
         ("tree and analytic", scaled_scene(1.0, Vec3::ZERO)),
     ] {
         let g = Geometry::build(&shapes);
-        if name == "small" {
+        if name.starts_with("small") {
             let n = g.triangle_count();
             assert!(n <= mltbench::geometry::flat::FLAT_LIMIT, "{n} triangles");
         }
@@ -919,6 +930,7 @@ fn packet_queries_match_single_ray_queries() {
         rays[18].o = Vec3::NAN;
         rays[33].t_max = -1.0;
         let (mut hits, mut blocked, mut clear) = (0, 0, 0);
+        let mut analytic_hits = 0;
         let mut closest = ClosestLanes::default();
         for (k, chunk) in rays.chunks_exact(16).enumerate() {
             let lanes =
@@ -953,6 +965,9 @@ fn packet_queries_match_single_ray_queries() {
                     continue;
                 };
                 hits += 1;
+                analytic_hits +=
+                    !matches!(shapes[want.shape as usize].geometry, ShapeGeometry::Mesh(_))
+                        as usize;
                 let got = g.interaction(&closest.closest_hit(&g, &packet, i).unwrap());
                 assert_eq!((got.shape, got.primitive), (want.shape, want.primitive));
                 assert_eq!(got.t.to_bits(), want.t.to_bits(), "{name}: {ray:?}");
@@ -981,5 +996,11 @@ fn packet_queries_match_single_ray_queries() {
             blocked > 100 && clear > 100,
             "{name}: {blocked} blocked, {clear} clear"
         );
+        if name.contains("analytic") {
+            assert!(
+                analytic_hits > 1000,
+                "{name}: {analytic_hits} analytic hits"
+            );
+        }
     }
 }

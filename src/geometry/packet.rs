@@ -10,12 +10,14 @@
 //! rounding error bound is settled from its own values; any other candidate goes through
 //! `triangle::intersect` itself. `tests/geometry.rs` compares both queries ray by ray.
 //!
-//! Scenes with a tree, and the analytic shapes of small scenes, are answered one lane at a
-//! time by the per-ray queries.
+//! The analytic shapes of a small scene come first, as in the per-ray queries: spheres in
+//! f64 lanes (`Sphere::intersect_lanes`, the same operations in the same order), disks one
+//! lane at a time; the triangles are then tested within what is left of each segment.
+//! Scenes with a tree are answered one lane at a time by the per-ray queries.
 
 use super::triangle::{self, BoundArithmetic, TriangleHit, TriangleRay, TriangleRecord};
 use super::{ClosestHit, Geometry, Hit, Ray, ScaledRay};
-use crate::math::lanes::{F32x16, LANES, Mask16, U32x16, V3};
+use crate::math::lanes::{F32x16, F64x8, LANES, Mask8, Mask16, U32x16, V3};
 
 /// Sixteen rays: origins, directions (need not be unit length) and segment ends.
 #[derive(Clone, Copy, Debug)]
@@ -145,6 +147,32 @@ fn pick(v: &V3<F32x16>, k: U32x16) -> F32x16 {
         v.x,
         F32x16::select(k.eq(U32x16::splat(1)), v.y, v.z),
     )
+}
+
+/// Scaled rays widened to f64 (exactly) in two halves of eight lanes, for the analytic
+/// shapes' tests.
+struct WideRays {
+    o: [(F64x8, F64x8); 3],
+    d: [(F64x8, F64x8); 3],
+    t_max: (F64x8, F64x8),
+}
+
+impl WideRays {
+    #[inline(always)]
+    fn new(r: &ScaledRayLanes) -> WideRays {
+        WideRays {
+            o: [r.o.x, r.o.y, r.o.z].map(F32x16::to_f64_halves),
+            d: [r.d.x, r.d.y, r.d.z].map(F32x16::to_f64_halves),
+            t_max: r.t_max.to_f64_halves(),
+        }
+    }
+
+    /// The origins and directions of half `h` (lanes 8h to 8h + 7).
+    #[inline(always)]
+    fn half(&self, h: usize) -> ([F64x8; 3], [F64x8; 3]) {
+        let pick = |v: &(F64x8, F64x8)| if h == 0 { v.0 } else { v.1 };
+        (self.o.each_ref().map(pick), self.d.each_ref().map(pick))
+    }
 }
 
 /// `TriangleRay::new` in lanes: the permutation as indices into a `PacketTriangle`, the
@@ -442,6 +470,9 @@ pub struct ClosestLanes {
     /// did (`one_by_one`).
     packet: bool,
     best: BestLanes,
+    /// With `packet`: each lane's closest sphere or disk hit (taken where no triangle is
+    /// closer, `best.hit` unset).
+    analytic: [Option<Hit>; LANES],
     one_by_one: [Option<ClosestHit>; LANES],
 }
 
@@ -458,6 +489,7 @@ impl Default for ClosestLanes {
                 det: zero,
                 hit: Mask16::NONE,
             },
+            analytic: [None; LANES],
             one_by_one: [None; LANES],
         }
     }
@@ -475,18 +507,22 @@ impl ClosestLanes {
         if !self.packet {
             return self.one_by_one[i];
         }
+        if !self.hit.get(i) {
+            return None;
+        }
         let ray = ScaledRay::new(&rays.lane(i))?;
-        self.hit.get(i).then(|| {
-            let g = |v: F32x16| v.to_array()[i];
-            let best = &self.best;
-            let hit = TriangleHit {
-                t: g(best.t),
-                e: best.e.map(g),
-                det: g(best.det),
-            };
-            let record = best.record.to_array()[i];
-            geometry.found(Hit::Triangle { record, hit }, ray)
-        })
+        if !self.best.hit.get(i) {
+            return self.analytic[i].map(|h| geometry.found(h, ray));
+        }
+        let g = |v: F32x16| v.to_array()[i];
+        let best = &self.best;
+        let hit = TriangleHit {
+            t: g(best.t),
+            e: best.e.map(g),
+            det: g(best.det),
+        };
+        let record = best.record.to_array()[i];
+        Some(geometry.found(Hit::Triangle { record, hit }, ray))
     }
 }
 
@@ -505,10 +541,10 @@ pub struct SurfaceLanes {
 
 impl Geometry {
     /// `closest_hit` for the rays of the lanes of `m`: the same answers, sixteen rays per
-    /// triangle test on a small scene without analytic shapes (`packet.rs`), one ray at a
-    /// time otherwise.
+    /// triangle and sphere test on a small scene (`packet.rs`), one ray at a time on a
+    /// scene with a tree.
     pub fn closest_hits_lanes(&self, rays: &RayLanes, m: Mask16, out: &mut ClosestLanes) {
-        if !self.bvh.is_flat() || self.has_analytic_shapes() {
+        if !self.bvh.is_flat() {
             out.packet = false;
             out.one_by_one = [None; LANES];
             for i in m.lanes() {
@@ -519,31 +555,143 @@ impl Geometry {
         }
         let scaled = ScaledRayLanes::new(rays);
         let m = m & scaled.valid;
+        // The analytic shapes first, then the triangles within what they left of each
+        // segment (`closest_hit_in`).
+        let (analytic, t_max) = self.closest_analytic_lanes(&scaled, m, &mut out.analytic);
         let tri = TriangleRayLanes::new(&scaled.o, &scaled.d);
         let tri_ray = |i: usize| {
             let s = &scaled.lanes()[i];
             TriangleRay::new(s.o, s.d)
         };
         out.packet = true;
-        self.bvh.packet().closest(
-            self.bvh.records(),
-            &tri,
-            tri_ray,
-            scaled.t_max,
-            m,
-            &mut out.best,
-        );
-        out.hit = out.best.hit;
+        self.bvh
+            .packet()
+            .closest(self.bvh.records(), &tri, tri_ray, t_max, m, &mut out.best);
+        out.hit = out.best.hit | analytic;
+    }
+
+    /// `closest_analytic` for the lanes of `m`: spheres in f64 lanes, disks one lane at a
+    /// time. Writes each lane's hit to `hits` and returns the lanes that hit and the
+    /// segment left for the triangles (t_max in the scaled rays' units, shortened to the
+    /// hit where there is one).
+    #[inline(always)]
+    fn closest_analytic_lanes(
+        &self,
+        r: &ScaledRayLanes,
+        m: Mask16,
+        hits: &mut [Option<Hit>; LANES],
+    ) -> (Mask16, F32x16) {
+        if !self.has_analytic_shapes() {
+            return (Mask16::NONE, r.t_max);
+        }
+        *hits = [None; LANES];
+        let wide = WideRays::new(r);
+        let (m_lo, m_hi) = m.halves();
+        let mut found = [Mask8::NONE; 2];
+        let mut t_max = [wide.t_max.0, wide.t_max.1];
+        for (h, m) in [m_lo, m_hi].into_iter().enumerate() {
+            let (o, d) = wide.half(h);
+            for (index, s) in self.spheres.iter().enumerate() {
+                let (hit, t) = s.intersect_lanes(&o, &d, t_max[h], m);
+                if hit.none() {
+                    continue;
+                }
+                t_max[h] = F64x8::select(hit, t, t_max[h]);
+                found[h] |= hit;
+                let t = t.to_array();
+                for i in hit.lanes() {
+                    hits[8 * h + i] = Some(Hit::Sphere { index, t: t[i] });
+                }
+            }
+        }
+        let mut found = Mask16::from_halves(found[0], found[1]);
+        if !self.disks.is_empty() {
+            let rays = r.lanes();
+            let mut t = [t_max[0].to_array(), t_max[1].to_array()];
+            for i in m.lanes() {
+                let t_max64 = &mut t[i / 8][i % 8];
+                for (index, disk) in self.disks.iter().enumerate() {
+                    if let Some((t, local)) = disk.intersect(rays[i].o, rays[i].d, *t_max64) {
+                        *t_max64 = t;
+                        hits[i] = Some(Hit::Disk { index, t, local });
+                        found.set(i, true);
+                    }
+                }
+            }
+            t_max = t.map(F64x8::from_array);
+        }
+        let shortened = F32x16::from_f64_halves(t_max[0], t_max[1]);
+        (found, F32x16::select(found, shortened, r.t_max))
+    }
+
+    /// Lanes of `m` whose segment meets a sphere or a disk (`occluded_in`'s first test).
+    #[inline(always)]
+    fn analytic_blocks_lanes(&self, r: &ScaledRayLanes, m: Mask16) -> Mask16 {
+        if !self.has_analytic_shapes() {
+            return Mask16::NONE;
+        }
+        let wide = WideRays::new(r);
+        let t_max = [wide.t_max.0, wide.t_max.1];
+        let (m_lo, m_hi) = m.halves();
+        let mut found = [Mask8::NONE; 2];
+        for (h, m) in [m_lo, m_hi].into_iter().enumerate() {
+            let (o, d) = wide.half(h);
+            for s in &self.spheres {
+                let open = m & !found[h];
+                if open.none() {
+                    break;
+                }
+                found[h] |= s.intersect_lanes(&o, &d, t_max[h], open).0;
+            }
+        }
+        let mut found = Mask16::from_halves(found[0], found[1]);
+        if !self.disks.is_empty() {
+            let rays = r.lanes();
+            for i in (m & !found).lanes() {
+                let t_max64 = rays[i].t_max as f64;
+                if self
+                    .disks
+                    .iter()
+                    .any(|d| d.intersect(rays[i].o, rays[i].d, t_max64).is_some())
+                {
+                    found.set(i, true);
+                }
+            }
+        }
+        found
     }
 
     /// The surface data of `hits`: in lanes for the sixteen-ray test's hits, through
     /// `interaction` lane by lane otherwise. Lane by lane the same bits as `interaction`.
     pub fn surface_lanes(&self, hits: &ClosestLanes, rays: &RayLanes) -> SurfaceLanes {
         if !hits.packet {
-            return self.surface_one_by_one(hits, rays);
+            return self.surface_one_by_one(hits, rays, hits.hit);
         }
+        let triangles = self.triangle_surface_lanes(hits);
+        // Sphere and disk hits through `interaction`, lane by lane.
+        let analytic = hits.hit & !hits.best.hit;
+        if analytic.none() {
+            return triangles;
+        }
+        let other = self.surface_one_by_one(hits, rays, analytic);
+        let m = analytic;
+        SurfaceLanes {
+            hit: hits.hit,
+            p: V3::select(m, other.p, triangles.p),
+            p_error: V3::select(m, other.p_error, triangles.p_error),
+            ng: V3::select(m, other.ng, triangles.ng),
+            ns: V3::select(m, other.ns, triangles.ns),
+            shape: U32x16::select(m, other.shape, triangles.shape),
+            primitive: U32x16::select(m, other.primitive, triangles.primitive),
+        }
+    }
+
+    /// `surface_lanes` for the lanes whose closest hit is a triangle the sixteen-ray test
+    /// found.
+    #[inline(always)]
+    fn triangle_surface_lanes(&self, hits: &ClosestLanes) -> SurfaceLanes {
         let best = &hits.best;
-        let m = hits.hit;
+        let m = best.hit;
         let packet = self.bvh.packet();
         let table = packet.triangles.as_flattened();
         let base = best.record.shl::<4>();
@@ -587,11 +735,11 @@ impl Geometry {
         }
     }
 
-    /// `surface_lanes` through `interaction`, one lane at a time.
-    fn surface_one_by_one(&self, hits: &ClosestLanes, rays: &RayLanes) -> SurfaceLanes {
+    /// `surface_lanes` through `interaction`, one lane at a time, for the lanes of `m`.
+    fn surface_one_by_one(&self, hits: &ClosestLanes, rays: &RayLanes, m: Mask16) -> SurfaceLanes {
         let mut v = [[[0.0f32; 3]; LANES]; 4];
         let (mut shape, mut primitive) = ([0u32; LANES], [0u32; LANES]);
-        for i in hits.hit.lanes() {
+        for i in m.lanes() {
             let Some(h) = hits.closest_hit(self, rays, i) else {
                 continue;
             };
@@ -619,19 +767,26 @@ impl Geometry {
     /// `occluded` for the rays of the lanes of `m`: the lanes whose segment is blocked
     /// (sixteen rays per triangle test where `closest_hits_lanes` uses it).
     pub fn occluded_lanes(&self, rays: &RayLanes, m: Mask16) -> Mask16 {
-        if !self.bvh.is_flat() || self.has_analytic_shapes() {
+        if !self.bvh.is_flat() {
             return Mask16::from_fn(|i| m.get(i) && self.occluded(&rays.lane(i)));
         }
         let scaled = ScaledRayLanes::new(rays);
         let m = m & scaled.valid;
+        let blocked = self.analytic_blocks_lanes(&scaled, m);
+        let m = m & !blocked;
+        if m.none() {
+            return blocked;
+        }
         let tri = TriangleRayLanes::new(&scaled.o, &scaled.d);
         let tri_ray = |i: usize| {
             let s = &scaled.lanes()[i];
             TriangleRay::new(s.o, s.d)
         };
-        self.bvh
-            .packet()
-            .any(self.bvh.records(), &tri, tri_ray, scaled.t_max, m)
+        blocked
+            | self
+                .bvh
+                .packet()
+                .any(self.bvh.records(), &tri, tri_ray, scaled.t_max, m)
     }
 
     fn has_analytic_shapes(&self) -> bool {

@@ -8,6 +8,7 @@ use glam::{DVec3, Vec2, Vec3};
 
 use super::AnalyticHit;
 use super::offset::gamma;
+use crate::math::lanes::{F64x8, Mask8};
 
 /// A sphere of `flip_normals` orientation, belonging to shape `shape`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -62,6 +63,50 @@ impl Sphere {
         } else {
             None
         }
+    }
+
+    /// `intersect` for eight rays in f64 lanes (origins `o` and directions `d` widened from
+    /// f32, segment ends `t_max`), lane by lane the same operations and so the same bits:
+    /// the lanes of `m` that hit, and their t.
+    #[inline(always)]
+    pub fn intersect_lanes(
+        &self,
+        o: &[F64x8; 3],
+        d: &[F64x8; 3],
+        t_max: F64x8,
+        m: Mask8,
+    ) -> (Mask8, F64x8) {
+        let splat = F64x8::splat;
+        let zero = splat(0.0);
+        // `DVec3::dot` and `DVec3::cross`, operation for operation.
+        let dot = |a: &[F64x8; 3], b: &[F64x8; 3]| (a[0] * b[0]) + (a[1] * b[1]) + (a[2] * b[2]);
+        let c = self.center.as_dvec3();
+        let f = [o[0] - splat(c.x), o[1] - splat(c.y), o[2] - splat(c.z)];
+        let r = self.radius as f64;
+        let a = dot(d, d);
+        let f_cross_d = [
+            f[1] * d[2] - d[1] * f[2],
+            f[2] * d[0] - d[2] * f[0],
+            f[0] * d[1] - d[0] * f[1],
+        ];
+        let a_disc = splat(r * r) * a - dot(&f_cross_d, &f_cross_d);
+        // Not NaN and not negative.
+        let real = m & zero.le(a_disc);
+        if real.none() {
+            return (Mask8::NONE, zero);
+        }
+        let b = dot(&f, d);
+        let c = dot(&f, &f) - splat(r * r);
+        let q = -(b + a_disc.sqrt().copysign(b));
+        let (x, y) = (c / q, q / a);
+        let ordered = x.le(y);
+        let double = q.eq(zero);
+        let t = -b / a;
+        let t0 = F64x8::select(double, t, F64x8::select(ordered, x, y));
+        let t1 = F64x8::select(double, t, F64x8::select(ordered, y, x));
+        let hit0 = t0.gt(zero) & t0.lt(t_max);
+        let hit1 = t1.gt(zero) & t1.lt(t_max);
+        (real & (hit0 | hit1), F64x8::select(hit0, t0, t1))
     }
 
     /// The surface data where `o + t·d` meets the sphere.

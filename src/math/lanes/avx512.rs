@@ -371,6 +371,11 @@ impl F64x8 {
     }
 
     #[inline(always)]
+    pub fn from_array(a: [f64; 8]) -> F64x8 {
+        F64x8(unsafe { _mm512_loadu_pd(a.as_ptr()) })
+    }
+
+    #[inline(always)]
     pub fn to_array(self) -> [f64; 8] {
         let mut a = [0.0f64; 8];
         unsafe { _mm512_storeu_pd(a.as_mut_ptr(), self.0) };
@@ -393,8 +398,42 @@ impl F64x8 {
     }
 
     #[inline(always)]
+    pub fn eq(self, o: F64x8) -> Mask8 {
+        Mask8(unsafe { _mm512_cmp_pd_mask::<_CMP_EQ_OQ>(self.0, o.0) })
+    }
+
+    #[inline(always)]
     pub fn select(m: Mask8, a: F64x8, b: F64x8) -> F64x8 {
         F64x8(unsafe { _mm512_mask_blend_pd(m.0, b.0, a.0) })
+    }
+
+    #[inline(always)]
+    pub fn sqrt(self) -> F64x8 {
+        F64x8(unsafe { _mm512_sqrt_pd(self.0) })
+    }
+
+    /// The magnitude of `self` with the sign of `sign` (`f64::copysign`).
+    #[inline(always)]
+    pub fn copysign(self, sign: F64x8) -> F64x8 {
+        unsafe {
+            let bits = |v: __m512d| _mm512_castpd_si512(v);
+            let s = _mm512_set1_epi64(i64::MIN);
+            let magnitude = _mm512_andnot_si512(s, bits(self.0));
+            let sign = _mm512_and_si512(s, bits(sign.0));
+            F64x8(_mm512_castsi512_pd(_mm512_or_si512(magnitude, sign)))
+        }
+    }
+}
+
+impl Neg for F64x8 {
+    type Output = F64x8;
+    #[inline(always)]
+    fn neg(self) -> F64x8 {
+        unsafe {
+            let flipped =
+                _mm512_xor_si512(_mm512_castpd_si512(self.0), _mm512_set1_epi64(i64::MIN));
+            F64x8(_mm512_castsi512_pd(flipped))
+        }
     }
 }
 

@@ -356,6 +356,11 @@ impl F64x8 {
     }
 
     #[inline(always)]
+    pub fn from_array(a: [f64; 8]) -> F64x8 {
+        F64x8(a)
+    }
+
+    #[inline(always)]
     pub fn to_array(self) -> [f64; 8] {
         self.0
     }
@@ -376,10 +381,34 @@ impl F64x8 {
     }
 
     #[inline(always)]
+    pub fn eq(self, o: F64x8) -> Mask8 {
+        Mask8::from_fn(|i| self.0[i] == o.0[i])
+    }
+
+    #[inline(always)]
     pub fn select(m: Mask8, a: F64x8, b: F64x8) -> F64x8 {
         F64x8(std::array::from_fn(
             |i| if m.get(i) { a.0[i] } else { b.0[i] },
         ))
+    }
+
+    #[inline(always)]
+    pub fn sqrt(self) -> F64x8 {
+        F64x8(self.0.map(f64::sqrt))
+    }
+
+    /// The magnitude of `self` with the sign of `sign` (`f64::copysign`).
+    #[inline(always)]
+    pub fn copysign(self, sign: F64x8) -> F64x8 {
+        F64x8(std::array::from_fn(|i| self.0[i].copysign(sign.0[i])))
+    }
+}
+
+impl Neg for F64x8 {
+    type Output = F64x8;
+    #[inline(always)]
+    fn neg(self) -> F64x8 {
+        F64x8(self.0.map(|a| -a))
     }
 }
 

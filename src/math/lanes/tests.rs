@@ -207,7 +207,15 @@ fn f64_lane_operations_equal_scalar_ones() {
         check((xa - xb).to_array(), &|p, q| p - q, "sub");
         check((xa * xb).to_array(), &|p, q| p * q, "mul");
         check((xa / xb).to_array(), &|p, q| p / q, "div");
+        check(xa.sqrt().to_array(), &|p, _| p.sqrt(), "sqrt");
+        check(
+            xa.copysign(xb).to_array(),
+            &|p, q| p.copysign(q),
+            "copysign",
+        );
+        check((-xa).to_array(), &|p, _| -p, "neg");
         for i in 0..8 {
+            assert_eq!(xa.eq(xb).get(i), pa[i] == pb[i]);
             assert_eq!(xa.lt(xb).get(i), pa[i] < pb[i]);
             assert_eq!(xa.le(xb).get(i), pa[i] <= pb[i]);
             assert_eq!(xa.gt(xb).get(i), pa[i] > pb[i]);
