@@ -561,6 +561,7 @@ fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
         "cbox-point.xml",
         "cbox-smalllight.xml",
         "cbox-spheres.xml",
+        "envmap-spheres.xml",
         "textures.xml",
         "textures-plastic.xml",
     ] {

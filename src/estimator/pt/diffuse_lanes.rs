@@ -1,4 +1,4 @@
-//! `PathSample::scatter` in lanes, for paths at an untextured `diffuse` surface: next-event
+//! `PathSample::scatter` in lanes, for paths at a `diffuse` surface: next-event
 //! estimation, cosine-weighted sampling of the next direction, Russian roulette. Every
 //! operation is the scalar code's, in its order (see `wavefront.rs`), with the scalar
 //! code's early returns turned into lane masks.
@@ -145,7 +145,7 @@ pub(super) fn power_heuristic_lanes(pdf_a: F32x16, pdf_b: F32x16, m: Mask16) -> 
 }
 
 impl PathSample {
-    /// `scatter` for the lanes of `m` (live, at an untextured `diffuse` surface). Returns
+    /// `scatter` for the lanes of `m` (live, at a `diffuse` surface, textured or not). Returns
     /// the lanes whose path ends here.
     pub(super) fn scatter_diffuse(
         &self,
@@ -162,22 +162,9 @@ impl PathSample {
         let mut wo = frame.to_local(-lanes.direction.normalize());
         // `TwoSided` seen from behind: the back side's reflectance, both directions
         // mirrored through the surface (a negated z, exact: the scalar code's bits).
-        let back = if tables.any_two_sided {
-            let two_sided = U32x16::gather(&tables.two_sided, hits.shape, m);
-            m & two_sided.eq(U32x16::splat(1)) & wo.z.lt(zero)
-        } else {
-            Mask16::NONE
-        };
-        let channel = |c: usize| {
-            let front = F32x16::gather(&tables.reflectance[c], hits.shape, m);
-            if back.none() {
-                front
-            } else {
-                let back_side = F32x16::gather(&tables.back_reflectance[c], hits.shape, m);
-                F32x16::select(back, back_side, front)
-            }
-        };
-        let rho = V3::new(channel(0), channel(1), channel(2));
+        let sides = tables.reflectances(scene, hits, m);
+        let back = sides.two_sided & wo.z.lt(zero);
+        let rho = V3::select(back, sides.back, sides.front);
         let mirror = |z: F32x16| F32x16::select(back, -z, z);
         wo.z = mirror(wo.z);
 

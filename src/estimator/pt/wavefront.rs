@@ -313,8 +313,8 @@ impl PathSample {
         lanes.rays = lanes.rays + U32x16::select(live, one, zero);
 
         // Arriving (`arrive`): emission found by the rays, in lanes for area lights on
-        // meshes and disks; escaped rays and other emitters by the scalar code. Every hit
-        // lane then checks the depth.
+        // meshes and disks and for lights at infinity; other emitters by the scalar code.
+        // Every hit lane then checks the depth.
         let light = U32x16::gather(&tables.light, hits.shape, hits.hit);
         let emitter = hits.hit & !light.eq(U32x16::splat(NO_LIGHT)) & lanes.shows_emitters;
         let scalar_emitters = self.emission_in_lanes(scene, lanes, hits, light, emitter, shadows);
@@ -326,8 +326,9 @@ impl PathSample {
         } else {
             escaped & lanes.shows_environment
         };
-        coverage.scalar += (sees_environment | scalar_emitters).count() as u64;
-        for lane in (sees_environment | scalar_emitters).lanes() {
+        self.environment_in_lanes(scene, lanes, sees_environment, shadows);
+        coverage.scalar += scalar_emitters.count() as u64;
+        for lane in scalar_emitters.lanes() {
             let mut state = self.take_path(scene, lanes, lane, queue, shadows);
             if !self.arrive(scene, &mut state, hits.interaction(scene, lane).as_ref()) {
                 ended.set(lane, true);
