@@ -547,10 +547,12 @@ fn pt_bits(scene: &Scene, params: &[&str], passes: u32, seed: u64) -> (Vec<u32>,
 
 /// `pt` traced sixteen paths at a time in SIMD lanes (`wavefront=true`) and one at a time
 /// (`wavefront=false`): the same image bits and the same counts, on every kind of scene the
-/// lanes treat differently (diffuse surfaces in lanes, `twosided` diffuse ones from both
-/// sides, other BSDFs and textures one lane at a time; small scenes cast sixteen rays per test, analytic shapes and trees one ray at a
-/// time; mesh lights sampled in lanes, other lights not; emitters hit, the environment
-/// reached, point lights, thin lenses, sample patterns, every depth rule, `hide_emitters`).
+/// lanes treat differently (diffuse surfaces, textured or not, and smooth mirrors and glass
+/// in lanes, `twosided` diffuse ones from both sides, other BSDFs one lane at a time; small
+/// scenes cast sixteen rays per test, spheres included, trees one ray at a time; mesh
+/// lights sampled in lanes, other lights not; emitters hit, constant and envmap
+/// environments reached, point lights, thin lenses, sample patterns, every depth rule,
+/// `hide_emitters`).
 #[test]
 fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
     let mut cases: Vec<(String, Scene, Vec<&str>)> = Vec::new();
@@ -640,6 +642,41 @@ fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
             </scene>"#,
             camera = camera(),
             enclosure = enclosure("cube", "0.5", "0.8"),
+        )),
+        vec![],
+    ));
+    // Smooth specular BSDFs of every kind the lanes sample (a tinted mirror; tinted,
+    // index-matched and inverted glass) beside a conductor with a complex IOR, which they
+    // leave to the scalar code.
+    cases.push((
+        "mirrors and glass".into(),
+        scene(&format!(
+            r#"<scene version="3.0.0">
+                {camera}
+                {enclosure}
+                {CBOX_LIGHT_RECTANGLE}<emitter type="area"><rgb name="radiance" value="5"/></emitter></shape>
+                <shape type="sphere"><point name="center" x="-0.5" y="-0.5" z="-2.5"/>
+                    <float name="radius" value="0.3"/>
+                    <bsdf type="conductor"><string name="material" value="none"/>
+                        <rgb name="specular_reflectance" value="0.9, 0.6, 0.3"/></bsdf></shape>
+                <shape type="sphere"><point name="center" x="0.1" y="-0.5" z="-2.2"/>
+                    <float name="radius" value="0.3"/>
+                    <bsdf type="dielectric"><float name="int_ior" value="1.7"/>
+                        <rgb name="specular_transmittance" value="0.5, 0.9, 0.7"/>
+                        <rgb name="specular_reflectance" value="0.8"/></bsdf></shape>
+                <shape type="cube"><transform name="to_world"><scale value="0.2"/>
+                    <translate x="0.6" y="-0.5" z="-2.4"/></transform>
+                    <bsdf type="dielectric"><float name="int_ior" value="1"/></bsdf></shape>
+                <shape type="sphere"><point name="center" x="0.2" y="0.3" z="-2.6"/>
+                    <float name="radius" value="0.25"/>
+                    <bsdf type="dielectric"><float name="int_ior" value="1"/>
+                        <float name="ext_ior" value="1.5"/></bsdf></shape>
+                <shape type="sphere"><point name="center" x="-0.4" y="0.3" z="-2.7"/>
+                    <float name="radius" value="0.25"/>
+                    <bsdf type="conductor"><string name="material" value="Au"/></bsdf></shape>
+            </scene>"#,
+            camera = camera(),
+            enclosure = enclosure("cube", "0.6", "0.1"),
         )),
         vec![],
     ));

@@ -8,6 +8,7 @@ use super::hit_lanes::HitLanes;
 use super::lane_scene::LaneScene;
 use super::path_lanes::{PathLanes, lane, lane3, put3, with_lane};
 use super::shadow_queue::ShadowQueue;
+use super::walk_lanes::SampleLanes;
 use crate::geometry::SHADOW_EPSILON;
 use crate::geometry::offset::offset_origin;
 use crate::geometry::packet::RayLanes;
@@ -113,18 +114,6 @@ impl NeeLanes {
             self.pdf_solid_angle = with_lane(self.pdf_solid_angle, i, ls.pdf_solid_angle);
         }
     }
-}
-
-/// Rust's `f32::max` per lane (a NaN operand gives the other one).
-#[inline(always)]
-fn max_num(a: F32x16, b: F32x16) -> F32x16 {
-    F32x16::select(a.is_nan(), b, F32x16::select(b.is_nan(), a, a.max_gt(b)))
-}
-
-/// Rust's `f32::min` per lane (a NaN operand gives the other one).
-#[inline(always)]
-fn min_num(a: F32x16, b: F32x16) -> F32x16 {
-    F32x16::select(a.is_nan(), b, F32x16::select(b.is_nan(), a, a.min_lt(b)))
 }
 
 /// `power_heuristic(a, b)` per lane: the f32 formula in lanes, and the scalar function
@@ -239,36 +228,13 @@ impl PathSample {
         let pdf = F32x16::select(wi.z.gt(zero), wi.z * inv_pi, zero);
         wi.z = mirror(wi.z);
         let sampled = m & !wo.z.le(zero) & !pdf.le(zero);
-        let mut ends = m & !sampled;
-        let c = sampled;
-        lanes.throughput = V3::select(c, lanes.throughput.mul_v(rho), lanes.throughput);
-        lanes.shows_emitters |= c;
-        lanes.shows_environment |= c;
-        lanes.prev_specular &= !c;
-        lanes.prev_p = V3::select(c, hits.p, lanes.prev_p);
-        lanes.prev_pdf = F32x16::select(c, pdf, lanes.prev_pdf);
-        let d = frame.to_world(wi);
-        lanes.origin = V3::select(
-            c,
-            offset_origin(hits.p, hits.p_error, hits.ng, d),
-            lanes.origin,
-        );
-        lanes.direction = V3::select(c, d, lanes.direction);
-        lanes.t_max = F32x16::select(c, F32x16::splat(f32::INFINITY), lanes.t_max);
-        lanes.depth = lanes.depth + U32x16::select(c, U32x16::splat(1), U32x16::splat(0));
-
-        // Russian roulette.
-        let t = lanes.throughput;
-        let max_throughput = max_num(max_num(t.x, t.y), t.z);
-        let dark = c & !(max_throughput.gt(zero) & max_throughput.is_finite());
-        ends |= dark;
-        let rr_depth = U32x16::splat(self.settings.path.rr_depth);
-        let roulette = c & !dark & !lanes.depth.lt(rr_depth);
-        let q = min_num(max_throughput * lanes.eta * lanes.eta, F32x16::splat(0.95));
-        let killed = roulette & u_roulette.ge(q);
-        ends |= killed;
-        let survived = roulette & !killed;
-        lanes.throughput = V3::select(survived, t.div_scalar(q), t);
-        ends
+        let sample = SampleLanes {
+            wi,
+            weight: rho,
+            pdf,
+            delta: Mask16::NONE,
+            eta: F32x16::splat(1.0),
+        };
+        (m & !sampled) | self.leave_lanes(lanes, hits, &frame, sampled, &sample, u_roulette)
     }
 }

@@ -35,7 +35,28 @@ pub(super) struct LaneScene {
     pub back_reflectance: [Vec<f32>; 3],
     /// Index of the shape's area light, or `NO_LIGHT`.
     pub light: Vec<u32>,
+    /// The smooth specular BSDFs the lanes sample (`specular_lanes.rs`), by shape.
+    pub specular: SpecularTables,
 }
+
+/// Which shapes have a smooth specular BSDF the lanes sample, and its parameters.
+pub(super) struct SpecularTables {
+    /// `MIRROR`, `GLASS`, or 0 for the other shapes.
+    pub kind: Vec<u32>,
+    /// Whether any shape has one.
+    pub any: bool,
+    /// η = η_inside/η_outside of a `dielectric` (1 elsewhere).
+    pub eta: Vec<f32>,
+    /// Specular reflectance's channels (a mirror's, or a dielectric's).
+    pub reflectance: [Vec<f32>; 3],
+    /// A dielectric's specular transmittance's channels.
+    pub transmittance: [Vec<f32>; 3],
+}
+
+/// An untextured `conductor` without a complex IOR: reflectance independent of the angle.
+pub(super) const MIRROR: u32 = 1;
+/// An untextured smooth `dielectric`.
+pub(super) const GLASS: u32 = 2;
 
 impl LaneScene {
     pub fn new(scene: &Scene) -> LaneScene {
@@ -52,7 +73,33 @@ impl LaneScene {
         };
         let (mut reflectance, mut back_reflectance) = (channels(), channels());
         let mut light = vec![NO_LIGHT; n.max(1)];
+        let mut specular = SpecularTables {
+            kind: vec![0; n.max(1)],
+            any: false,
+            eta: vec![1.0; n.max(1)],
+            reflectance: channels(),
+            transmittance: channels(),
+        };
         for shape in 0..n {
+            let (kind, mirror_or_glass, transmittance, eta) = match scene.untextured_bsdf(shape) {
+                Some(Bsdf::Conductor(c)) if c.eta_k.is_none() => {
+                    (MIRROR, c.specular_reflectance, Rgb::BLACK, 1.0)
+                }
+                Some(Bsdf::Dielectric(d)) => (
+                    GLASS,
+                    d.specular_reflectance,
+                    d.specular_transmittance,
+                    d.eta,
+                ),
+                _ => (0, Rgb::BLACK, Rgb::BLACK, 1.0),
+            };
+            specular.kind[shape] = kind;
+            specular.any |= kind != 0;
+            specular.eta[shape] = eta;
+            for c in 0..3 {
+                specular.reflectance[c][shape] = mirror_or_glass[c];
+                specular.transmittance[c][shape] = transmittance[c];
+            }
             // A textured BSDF keeps its kind (`Bsdf::at_point`): a textured `diffuse` is a
             // `diffuse` at every point.
             let has_texture = scene.untextured_bsdf(shape).is_none();
@@ -80,6 +127,7 @@ impl LaneScene {
             reflectance,
             back_reflectance,
             light,
+            specular,
         }
     }
 }

@@ -29,6 +29,8 @@ mod lane_scene;
 mod lane_share;
 mod path_lanes;
 mod shadow_queue;
+mod specular_lanes;
+mod walk_lanes;
 mod wavefront;
 
 use super::camera_pass::{

@@ -338,13 +338,23 @@ impl PathSample {
         let deep = !(lanes.depth + one).lt(U32x16::splat(self.max_depth()));
         ended |= hits.hit & !scalar_emitters & deep;
 
-        // Scattering: diffuse surfaces in lanes, the others one by one.
+        // Scattering: diffuse and smooth specular surfaces in lanes, the others one by one.
         let going = live & !ended;
         let diffuse = going & U32x16::gather(&tables.diffuse, hits.shape, going).eq(one);
         ended |= self.scatter_diffuse(scene, tables, lanes, hits, diffuse, shadows);
         shadows.cast_full(&scene.geometry, queue);
-        coverage.scalar += (going & !diffuse).count() as u64;
-        for lane in (going & !diffuse).lanes() {
+        let specular = if tables.specular.any {
+            let kind = U32x16::gather(&tables.specular.kind, hits.shape, going & !diffuse);
+            going & !diffuse & !kind.eq(zero)
+        } else {
+            Mask16::NONE
+        };
+        if specular.any() {
+            ended |= self.scatter_specular(&tables.specular, lanes, hits, specular);
+        }
+        let scalar = going & !diffuse & !specular;
+        coverage.scalar += scalar.count() as u64;
+        for lane in scalar.lanes() {
             let mut state = self.take_path(scene, lanes, lane, queue, shadows);
             let mut sampler = IndependentSampler::with_state(0, lanes.streams.lane(lane));
             let si = hits
