@@ -39,6 +39,9 @@ pub struct EnvmapLight {
     cos_rows: Vec<f32>,
     /// None when the map is black everywhere.
     cells: Option<Distribution2D>,
+    /// Per cell (row-major, W × (H − 1)): its probability over its solid angle, the
+    /// density of a direction drawn in it (empty when `cells` is None).
+    cell_density: Vec<f32>,
     sphere: SceneSphere,
     power: f32,
 }
@@ -147,6 +150,13 @@ impl EnvmapLight {
             }
         }
         let cells = Distribution2D::new(&f32_weights(&weights), width, rows);
+        let cell_solid_angle = |j: usize| 2.0 * PI / width as f32 * (cos_rows[j] - cos_rows[j + 1]);
+        let cell_density = cells.as_ref().map_or_else(Vec::new, |c| {
+            (0..rows)
+                .flat_map(|j| (0..width).map(move |i| (i, j)))
+                .map(|(i, j)| c.cell_probability(i, j) / cell_solid_angle(j))
+                .collect()
+        });
         let r = sphere.radius as f64;
         // Only compared with other lights' powers: saturate rather than become infinite.
         let power = (std::f64::consts::PI * r * r * flux).min(f32::MAX as f64) as f32;
@@ -159,6 +169,7 @@ impl EnvmapLight {
             to_local,
             cos_rows,
             cells,
+            cell_density,
             sphere,
             power,
         })
@@ -217,11 +228,6 @@ impl EnvmapLight {
         top * (1.0 - fy) + bottom * fy
     }
 
-    /// Solid angle of the cells in row j.
-    fn cell_solid_angle(&self, j: usize) -> f32 {
-        2.0 * PI / self.width as f32 * (self.cos_rows[j] - self.cos_rows[j + 1])
-    }
-
     /// A world direction towards the environment, its solid-angle density and the radiance
     /// from it, read at the sample's own texel coordinates (`lookup` of the direction would
     /// first recover them).
@@ -245,7 +251,7 @@ impl EnvmapLight {
         let (sin_phi, cos_phi) = phi.sin_cos();
         let local = Vec3::new(sin_phi * sin, cos, -cos_phi * sin);
         let wi = (self.to_world * local).normalize();
-        let pdf = cells.cell_probability(iu, iv) / self.cell_solid_angle(iv);
+        let pdf = self.cell_density[iv * self.width + iu];
         (pdf > 0.0 && pdf.is_finite() && wi.is_finite()).then_some(TexelDirection {
             wi,
             pdf,
@@ -256,21 +262,31 @@ impl EnvmapLight {
 
     /// Solid-angle density of `sample_with_radiance` producing world direction `wi`.
     pub fn pdf_direction(&self, wi: Vec3) -> f32 {
-        let Some(cells) = self.cells.as_ref() else {
+        if self.cells.is_none() {
             return 0.0;
-        };
+        }
         let d = (self.to_local * wi).normalize_or_zero();
         if d == Vec3::ZERO {
             return 0.0;
         }
         let iu = (self.column_coordinate(d) as usize).min(self.width - 1);
-        // Row band j holds cos θ in [cos_rows[j+1], cos_rows[j]] (cos θ decreasing in j).
-        let cos = d.y.clamp(-1.0, 1.0);
+        let iv = self.row_band(d.y.clamp(-1.0, 1.0));
+        self.cell_density[iv * self.width + iu]
+    }
+
+    /// The row band j whose cells hold cos θ = `cos`, cos θ in [cos_rows[j+1], cos_rows[j]]
+    /// (decreasing in j): the number of cos_rows[1..H−1] above `cos`. Found by stepping from
+    /// the row coordinate's estimate, a step or two, instead of a binary search.
+    fn row_band(&self, cos: f32) -> usize {
         let rows = self.height - 1;
-        let iv = self.cos_rows[1..rows]
-            .partition_point(|&c| c > cos)
-            .min(rows - 1);
-        cells.cell_probability(iu, iv) / self.cell_solid_angle(iv)
+        let mut j = (self.row_coordinate(cos) as usize).min(rows - 1);
+        while j > 0 && !(self.cos_rows[j] > cos) {
+            j -= 1;
+        }
+        while j + 1 < rows && self.cos_rows[j + 1] > cos {
+            j += 1;
+        }
+        j
     }
 
     pub fn sample_li(&self, u: Vec2) -> Option<LightSample> {
@@ -313,6 +329,49 @@ struct TexelDirection {
     pdf: f32,
     x: f32,
     cos: f32,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `row_band` counts the rows above a cosine exactly as a binary search over them does,
+    /// for maps of a few and of many rows, at every row's own cosine, its neighbouring
+    /// floats, and a fine sweep of [−1, 1].
+    #[test]
+    fn row_band_agrees_with_a_binary_search() {
+        for height in [3usize, 4, 7, 64, 1001, 4097] {
+            let texels = vec![Rgb::WHITE; 2 * height];
+            let sphere = SceneSphere {
+                center: Vec3::ZERO,
+                radius: 1.0,
+            };
+            let map = EnvmapLight::from_texels(
+                Path::new("test"),
+                2,
+                height,
+                &texels,
+                1.0,
+                &Transform::IDENTITY,
+                sphere,
+            )
+            .unwrap();
+            let rows = height - 1;
+            let search = |cos: f32| {
+                map.cos_rows[1..rows]
+                    .partition_point(|&c| c > cos)
+                    .min(rows - 1)
+            };
+            let mut cosines: Vec<f32> = (0..=20_000).map(|k| -1.0 + k as f32 / 10_000.0).collect();
+            for &c in &map.cos_rows {
+                cosines.extend([c, c.next_up(), c.next_down()]);
+            }
+            for cos in cosines {
+                let cos = cos.clamp(-1.0, 1.0);
+                assert_eq!(map.row_band(cos), search(cos), "H = {height}, cos = {cos}");
+            }
+        }
+    }
 }
 
 fn luminance_f64(c: &Rgb) -> f64 {
