@@ -280,7 +280,8 @@ impl EnvmapLight {
     fn row_band(&self, cos: f32) -> usize {
         let rows = self.height - 1;
         let mut j = (self.row_coordinate(cos) as usize).min(rows - 1);
-        while j > 0 && !(self.cos_rows[j] > cos) {
+        // (A NaN cosine starts and stays at row 0, as the search puts it.)
+        while j > 0 && self.cos_rows[j] <= cos {
             j -= 1;
         }
         while j + 1 < rows && self.cos_rows[j + 1] > cos {
@@ -331,6 +332,33 @@ struct TexelDirection {
     cos: f32,
 }
 
+fn luminance_f64(c: &Rgb) -> f64 {
+    0.2126 * c.0[0] as f64 + 0.7152 * c.0[1] as f64 + 0.0722 * c.0[2] as f64
+}
+
+/// The cells' weights as f32 for `Distribution2D`: scaled by a power of two (exact) when
+/// their sum would come near f32's range, and every positive weight kept positive, so each
+/// cell whose radiance is not zero stays drawable.
+fn f32_weights(weights: &[f64]) -> Vec<f32> {
+    const MAX_SUM: f64 = 1e30;
+    let sum: f64 = weights.iter().sum();
+    let factor = if sum > MAX_SUM {
+        2f64.powi(-((sum / MAX_SUM).log2().ceil() as i32))
+    } else {
+        1.0
+    };
+    weights
+        .iter()
+        .map(|&w| {
+            if w > 0.0 {
+                ((w * factor) as f32).max(f32::MIN_POSITIVE)
+            } else {
+                0.0
+            }
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -372,31 +400,4 @@ mod tests {
             }
         }
     }
-}
-
-fn luminance_f64(c: &Rgb) -> f64 {
-    0.2126 * c.0[0] as f64 + 0.7152 * c.0[1] as f64 + 0.0722 * c.0[2] as f64
-}
-
-/// The cells' weights as f32 for `Distribution2D`: scaled by a power of two (exact) when
-/// their sum would come near f32's range, and every positive weight kept positive, so each
-/// cell whose radiance is not zero stays drawable.
-fn f32_weights(weights: &[f64]) -> Vec<f32> {
-    const MAX_SUM: f64 = 1e30;
-    let sum: f64 = weights.iter().sum();
-    let factor = if sum > MAX_SUM {
-        2f64.powi(-((sum / MAX_SUM).log2().ceil() as i32))
-    } else {
-        1.0
-    };
-    weights
-        .iter()
-        .map(|&w| {
-            if w > 0.0 {
-                ((w * factor) as f32).max(f32::MIN_POSITIVE)
-            } else {
-                0.0
-            }
-        })
-        .collect()
 }
