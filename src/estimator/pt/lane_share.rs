@@ -1,11 +1,12 @@
 //! How much of a scene's path vertices `pt`'s SIMD lanes handle themselves, measured while
 //! it renders, and the choice it drives.
 //!
-//! The lanes scatter on untextured diffuse surfaces and add area lights' emission; every
-//! other vertex (glossy or specular BSDFs, textures, an environment) is handed to the
-//! scalar code one lane at a time, which costs a transposition of the path's state out of
-//! the lanes and back. Where most vertices go that way, tracing one path at a time is
-//! faster (on the performance suite's environment map, water and glossy scenes by 10–20%).
+//! The lanes scatter on diffuse surfaces (textured or not), smooth mirrors and glass, and
+//! add the emission of area lights and of the environment; every other vertex (rough and
+//! glossy BSDFs, plastic, other emitters) is handed to the scalar code one lane at a time,
+//! which costs a transposition of the path's state out of the lanes and back. Where most
+//! vertices go that way, tracing one path at a time is faster (10–20% on scenes made
+//! mostly of such surfaces).
 //! The image is the same bit for bit either way (`tests/pt.rs`), so the choice, made
 //! batch by batch from the counts so far, changes only the speed.
 

@@ -289,6 +289,7 @@ impl PathSample {
     }
 
     /// Advances every live lane by one vertex; lanes whose path ends write it to `queue`.
+    #[inline(always)]
     fn advance_lanes(
         &self,
         pass: &PassContext,
