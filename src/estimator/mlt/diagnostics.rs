@@ -81,6 +81,10 @@ pub struct Diagnostics {
     pub large_step: f64,
     pub mutation: String,
     pub kelemen_weights: bool,
+    /// `luminance` or `relative` (`importance.rs`).
+    pub importance: String,
+    /// `importance=relative`: the pilot's block side in pixels (set by the estimator).
+    pub pilot_block: Option<u32>,
     pub bootstrap: Bootstrap,
     pub chains: u64,
     /// Chains that accepted no proposal.
@@ -137,6 +141,8 @@ impl Diagnostics {
                 Mutation::Gaussian { sigma } => format!("gaussian sigma={sigma}"),
             },
             kelemen_weights: settings.kelemen_weights,
+            importance: settings.importance.name().to_string(),
+            pilot_block: None,
             bootstrap: bootstrap.clone(),
             chains: chains.len() as u64,
             chains_never_moved: chains

@@ -16,6 +16,9 @@
 //!   taken one at a time or in chunks. One thread merges a pass's lists while the chains
 //!   take the next pass; the last pass's lists wait for the next call or for `image()`.
 //! * Image = b × (expected-value splats) / mutations per pixel (`chain`).
+//! * `importance`: the target is the luminance of a state's contributions, or with
+//!   `importance=relative` their luminance relative to a pilot estimate of each pixel, made
+//!   from the bootstrap's own samples.
 //! * `diagnostics` (JSON beside every image): acceptance, b and its standard error, chains
 //!   that never moved, the integrated autocorrelation time of the chains' importance and
 //!   the effective sample size, mutations per second.
@@ -23,6 +26,7 @@
 pub mod autocorrelation;
 pub mod chain;
 pub mod diagnostics;
+pub mod importance;
 pub mod multiplexed;
 pub mod settings;
 pub mod target;
@@ -43,6 +47,8 @@ use crate::sampler::primary_sample::PrimarySampleSampler;
 use crate::scene::Scene;
 use chain::{Chain, ChainCounts};
 use diagnostics::{Bootstrap, Diagnostics};
+use glam::Vec2;
+use importance::{ImportanceKind, PilotMap};
 use multiplexed::MultiplexedTarget;
 use settings::ChainSettings;
 use target::{BdptTarget, Contributions, PathTarget, PtTarget};
@@ -70,6 +76,8 @@ pub struct Metropolis<T: PathTarget> {
     chains: Vec<Chain>,
     /// What the bootstrap found (None before the first pass).
     bootstrap: Option<Bootstrap>,
+    /// `importance=relative`: the pilot the importance divides by (from the bootstrap).
+    pilot: Option<PilotMap>,
     stats: Stats,
     /// Seconds spent in passes (bootstrap included).
     seconds: f64,
@@ -154,6 +162,14 @@ fn check_lights(scene: &Scene, name: &str) -> Result<()> {
     Ok(())
 }
 
+/// One bootstrap point as `start` evaluated it.
+struct BootstrapPoint {
+    luminance: f32,
+    /// `importance=relative`: its contributions' (raster position, luminance).
+    entries: Vec<(Vec2, f64)>,
+    rays: u64,
+}
+
 /// Adds `lists` to `film` in order and empties them.
 fn merge(film: &mut Film, lists: &mut [SplatList]) {
     for list in lists {
@@ -193,6 +209,7 @@ impl<T: PathTarget> Metropolis<T> {
             fresh: Vec::new(),
             chains: Vec::new(),
             bootstrap: None,
+            pilot: None,
             stats: Stats::default(),
             seconds: 0.0,
             bootstrap_seconds: 0.0,
@@ -223,10 +240,12 @@ impl<T: PathTarget> Metropolis<T> {
         let strata = self.target.strata();
         let n = self.settings.bootstrap as u64;
         let seed = self.seed;
+        let relative = self.settings.importance == ImportanceKind::Relative;
         let this = &*self;
-        // Importance of every bootstrap point, stratum by stratum; each point's numbers
-        // come from its own key, so the order of evaluation does not matter.
-        let evaluated: Vec<(f32, u64)> = (0..strata as u64 * n)
+        // Every bootstrap point, stratum by stratum: its luminance, or with
+        // `importance=relative` its contributions' (raster, luminance) for the pilot; each
+        // point's numbers come from its own key, so the order of evaluation does not matter.
+        let evaluated: Vec<BootstrapPoint> = (0..strata as u64 * n)
             .into_par_iter()
             .map_init(
                 || (T::Scratch::default(), Contributions::default()),
@@ -236,12 +255,41 @@ impl<T: PathTarget> Metropolis<T> {
                     let e = this
                         .target
                         .evaluate(scene, &mut sampler, Some(stratum), scratch, out);
-                    (out.luminance as f32, e.rays)
+                    let entries = if relative {
+                        out.entries
+                            .iter()
+                            .map(|&(raster, v)| (raster, v.luminance() as f64))
+                            .collect()
+                    } else {
+                        Vec::new()
+                    };
+                    BootstrapPoint {
+                        luminance: out.luminance as f32,
+                        entries,
+                        rays: e.rays,
+                    }
                 },
             )
             .collect();
-        self.stats.rays += evaluated.iter().map(|e| e.1).sum::<u64>();
-        let importance: Vec<f32> = evaluated.into_iter().map(|e| e.0).collect();
+        self.stats.rays += evaluated.iter().map(|e| e.rays).sum::<u64>();
+        if relative {
+            let (width, height) = (self.film.width(), self.film.height());
+            let all = evaluated.iter().flat_map(|e| e.entries.iter().copied());
+            self.pilot = Some(PilotMap::new(width, height, strata as u64 * n, n, all));
+        }
+        let pilot = self.pilot.as_ref();
+        let importance: Vec<f32> = evaluated
+            .iter()
+            .map(|point| match pilot {
+                Some(map) => point
+                    .entries
+                    .iter()
+                    .map(|&(raster, l)| l / map.at(raster))
+                    .sum::<f64>() as f32,
+                None => point.luminance,
+            })
+            .collect();
+        drop(evaluated);
         let bootstrap = Bootstrap::new(&importance, strata, n);
         self.target.set_stratum_means(&bootstrap.stratum_means);
         if !(bootstrap.b > 0.0 && bootstrap.b.is_finite()) {
@@ -285,6 +333,9 @@ impl<T: PathTarget> Metropolis<T> {
                 sampler.restart_evaluation();
                 this.target
                     .evaluate(scene, &mut sampler, None, &mut scratch, &mut out);
+                if let Some(map) = &this.pilot {
+                    out.luminance = map.importance(&out);
+                }
                 sampler.start_chain(&[seed, CHAIN_KEY, k]);
                 Chain::new(sampler, out)
             })
@@ -305,7 +356,7 @@ impl<T: PathTarget> Metropolis<T> {
     /// The diagnostics so far (None before the first pass).
     pub fn diagnostics_report(&self) -> Option<Diagnostics> {
         let bootstrap = self.bootstrap.as_ref()?;
-        Some(Diagnostics::new(
+        let mut report = Diagnostics::new(
             self.name,
             self.base,
             &self.settings,
@@ -313,7 +364,9 @@ impl<T: PathTarget> Metropolis<T> {
             &self.chains,
             self.seconds,
             self.bootstrap_seconds,
-        ))
+        );
+        report.pilot_block = self.pilot.as_ref().map(PilotMap::block_size);
+        Some(report)
     }
 }
 
@@ -347,8 +400,10 @@ impl<T: PathTarget> Estimator for Metropolis<T> {
             film,
             pending,
             fresh,
+            pilot,
             ..
         } = self;
+        let pilot = &*pilot;
         for _ in 0..count {
             // One list per chain (after a swap `fresh` holds the lists just merged, or none
             // before the first pass).
@@ -368,6 +423,9 @@ impl<T: PathTarget> Estimator for Metropolis<T> {
                             for _ in 0..share(pixels, n_chains, k as u64) {
                                 chain.step(&settings, b, list, |sampler, out| {
                                     let e = target.evaluate(scene, sampler, None, scratch, out);
+                                    if let Some(map) = pilot {
+                                        out.luminance = map.importance(out);
+                                    }
                                     (e.rays, e.invalid)
                                 });
                             }

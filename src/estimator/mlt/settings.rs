@@ -1,6 +1,7 @@
 //! The Metropolis estimators' settings (docs/DESIGN.md §3): the mutation, the bootstrap and
 //! the chains, shared by `pssmlt` and `mmlt`.
 
+use super::importance::ImportanceKind;
 use crate::error::{Error, Result};
 use crate::estimator::Params;
 use crate::sampler::primary_sample::Mutation;
@@ -18,11 +19,14 @@ pub struct ChainSettings {
     /// Kelemen et al. 2002's weighting of large steps (their MIS of the chain's samples
     /// with the large steps' independent ones), instead of plain expected-value splatting.
     pub kelemen_weights: bool,
+    /// What the target density is proportional to (`importance.rs`).
+    pub importance: ImportanceKind,
 }
 
 impl ChainSettings {
-    /// Reads `large_step`, `mutation`, `s1`, `s2`, `sigma`, `bootstrap`, `chains` and, when
-    /// `with_kelemen_weights`, `kelemen_weights`; each bad value is an error naming it.
+    /// Reads `large_step`, `mutation`, `s1`, `s2`, `sigma`, `bootstrap`, `chains`,
+    /// `importance` and, when `with_kelemen_weights`, `kelemen_weights`; each bad value is
+    /// an error naming it.
     pub fn from_params(params: &Params, with_kelemen_weights: bool) -> Result<ChainSettings> {
         let large_step: f64 = params.get("large_step", 0.3)?;
         if !(0.0..=1.0).contains(&large_step) {
@@ -75,12 +79,22 @@ impl ChainSettings {
         } else {
             false
         };
+        let importance = match params.get("importance", "luminance".to_string())?.as_str() {
+            "luminance" => ImportanceKind::Luminance,
+            "relative" => ImportanceKind::Relative,
+            other => {
+                return Err(Error::usage(format!(
+                    "--set importance={other}: expected luminance or relative"
+                )));
+            }
+        };
         Ok(ChainSettings {
             large_step,
             mutation,
             bootstrap,
             chains,
             kelemen_weights,
+            importance,
         })
     }
 }
@@ -99,6 +113,7 @@ mod tests {
         assert_eq!(d.large_step, 0.3);
         assert_eq!(d.chains, 256);
         assert_eq!(d.bootstrap, 100_000);
+        assert_eq!(d.importance, ImportanceKind::Luminance);
         assert_eq!(
             d.mutation,
             Mutation::Kelemen {
@@ -113,6 +128,7 @@ mod tests {
             ("bootstrap=0", "bootstrap"),
             ("s2=0.0001", "s2"),
             ("mutation=uniform", "mutation"),
+            ("importance=radiance", "importance"),
         ] {
             let e = settings(&[bad]).unwrap_err().to_string();
             assert!(e.contains(name), "{bad}: {e}");
