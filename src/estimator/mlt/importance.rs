@@ -15,10 +15,13 @@
 //! contribution is (the pilot is floored at `FLOOR` of its mean). A poor pilot costs
 //! variance, never bias.
 //!
-//! The pilot is the bootstrap itself, which costs nothing extra: its samples are
-//! independent samples of the base estimator, so their contributions, binned into blocks of
-//! pixels (about `SAMPLES_PER_BLOCK` samples each) and smoothed over the neighbouring
-//! blocks, estimate each block's mean pixel luminance.
+//! The pilot is `bootstrap` independent samples of the base estimator of its own (the
+//! estimator draws them before the bootstrap, `Metropolis::make_pilot`): their
+//! contributions, binned into blocks of pixels (about `SAMPLES_PER_BLOCK` samples each)
+//! and smoothed over the neighbouring blocks, estimate each block's mean pixel luminance.
+//! It must not reuse the bootstrap's samples: b is their mean importance, and the blocks
+//! where they found no light are floored, so have the largest importance, which those
+//! samples by construction never show: b would come out too small.
 
 use glam::Vec2;
 

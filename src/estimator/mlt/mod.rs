@@ -18,7 +18,7 @@
 //! * Image = b × (expected-value splats) / mutations per pixel (`chain`).
 //! * `importance`: the target is the luminance of a state's contributions, or with
 //!   `importance=relative` their luminance relative to a pilot estimate of each pixel, made
-//!   from the bootstrap's own samples.
+//!   from independent points of its own before the bootstrap.
 //! * `diagnostics` (JSON beside every image): acceptance, b and its standard error, chains
 //!   that never moved, the integrated autocorrelation time of the chains' importance and
 //!   the effective sample size, mutations per second.
@@ -57,6 +57,7 @@ use target::{BdptTarget, Contributions, PathTarget, PtTarget};
 const BOOTSTRAP_KEY: u64 = 0xB007;
 const CHAIN_KEY: u64 = 0xC4A1;
 const SELECT_KEY: u64 = 0x5E1E;
+const PILOT_KEY: u64 = 0x9107;
 
 /// A Metropolis estimator over path function `T`.
 pub struct Metropolis<T: PathTarget> {
@@ -162,14 +163,6 @@ fn check_lights(scene: &Scene, name: &str) -> Result<()> {
     Ok(())
 }
 
-/// One bootstrap point as `start` evaluated it.
-struct BootstrapPoint {
-    luminance: f32,
-    /// `importance=relative`: its contributions' (raster position, luminance).
-    entries: Vec<(Vec2, f64)>,
-    rays: u64,
-}
-
 /// Adds `lists` to `film` in order and empties them.
 fn merge(film: &mut Film, lists: &mut [SplatList]) {
     for list in lists {
@@ -235,17 +228,50 @@ impl<T: PathTarget> Metropolis<T> {
         PrimarySampleSampler::new(key, self.settings.large_step, self.settings.mutation)
     }
 
-    /// The bootstrap, then the chains' first states.
-    fn start(&mut self, scene: &Scene) {
+    /// `importance=relative`'s pilot: `bootstrap` independent points per stratum of their
+    /// own (not the bootstrap's: b must be estimated from points the pilot did not see, or
+    /// the blocks where the pilot found no light, whose importance is largest, would be
+    /// missing from b by construction and the image would come out too dark).
+    fn make_pilot(&mut self, scene: &Scene) {
         let strata = self.target.strata();
         let n = self.settings.bootstrap as u64;
         let seed = self.seed;
-        let relative = self.settings.importance == ImportanceKind::Relative;
         let this = &*self;
-        // Every bootstrap point, stratum by stratum: its luminance, or with
-        // `importance=relative` its contributions' (raster, luminance) for the pilot; each
-        // point's numbers come from its own key, so the order of evaluation does not matter.
-        let evaluated: Vec<BootstrapPoint> = (0..strata as u64 * n)
+        let evaluated: Vec<(Vec<(Vec2, f64)>, u64)> = (0..strata as u64 * n)
+            .into_par_iter()
+            .map_init(
+                || (T::Scratch::default(), Contributions::default()),
+                |(scratch, out), j| {
+                    let mut sampler = this.sampler(&[seed, PILOT_KEY, j]);
+                    let stratum = (j / n) as usize;
+                    let e = this
+                        .target
+                        .evaluate(scene, &mut sampler, Some(stratum), scratch, out);
+                    let entries = out.entries.iter();
+                    let entries = entries.map(|&(raster, v)| (raster, v.luminance() as f64));
+                    (entries.collect(), e.rays)
+                },
+            )
+            .collect();
+        self.stats.rays += evaluated.iter().map(|e| e.1).sum::<u64>();
+        let (width, height) = (self.film.width(), self.film.height());
+        let all = evaluated.iter().flat_map(|e| e.0.iter().copied());
+        self.pilot = Some(PilotMap::new(width, height, strata as u64 * n, n, all));
+    }
+
+    /// The bootstrap (after the pilot, with `importance=relative`), then the chains' first
+    /// states.
+    fn start(&mut self, scene: &Scene) {
+        if self.settings.importance == ImportanceKind::Relative {
+            self.make_pilot(scene);
+        }
+        let strata = self.target.strata();
+        let n = self.settings.bootstrap as u64;
+        let seed = self.seed;
+        let this = &*self;
+        // Importance of every bootstrap point, stratum by stratum; each point's numbers
+        // come from its own key, so the order of evaluation does not matter.
+        let evaluated: Vec<(f32, u64)> = (0..strata as u64 * n)
             .into_par_iter()
             .map_init(
                 || (T::Scratch::default(), Contributions::default()),
@@ -255,41 +281,15 @@ impl<T: PathTarget> Metropolis<T> {
                     let e = this
                         .target
                         .evaluate(scene, &mut sampler, Some(stratum), scratch, out);
-                    let entries = if relative {
-                        out.entries
-                            .iter()
-                            .map(|&(raster, v)| (raster, v.luminance() as f64))
-                            .collect()
-                    } else {
-                        Vec::new()
-                    };
-                    BootstrapPoint {
-                        luminance: out.luminance as f32,
-                        entries,
-                        rays: e.rays,
+                    if let Some(map) = &this.pilot {
+                        out.luminance = map.importance(out);
                     }
+                    (out.luminance as f32, e.rays)
                 },
             )
             .collect();
-        self.stats.rays += evaluated.iter().map(|e| e.rays).sum::<u64>();
-        if relative {
-            let (width, height) = (self.film.width(), self.film.height());
-            let all = evaluated.iter().flat_map(|e| e.entries.iter().copied());
-            self.pilot = Some(PilotMap::new(width, height, strata as u64 * n, n, all));
-        }
-        let pilot = self.pilot.as_ref();
-        let importance: Vec<f32> = evaluated
-            .iter()
-            .map(|point| match pilot {
-                Some(map) => point
-                    .entries
-                    .iter()
-                    .map(|&(raster, l)| l / map.at(raster))
-                    .sum::<f64>() as f32,
-                None => point.luminance,
-            })
-            .collect();
-        drop(evaluated);
+        self.stats.rays += evaluated.iter().map(|e| e.1).sum::<u64>();
+        let importance: Vec<f32> = evaluated.into_iter().map(|e| e.0).collect();
         let bootstrap = Bootstrap::new(&importance, strata, n);
         self.target.set_stratum_means(&bootstrap.stratum_means);
         if !(bootstrap.b > 0.0 && bootstrap.b.is_finite()) {
