@@ -228,35 +228,50 @@ impl<T: PathTarget> Metropolis<T> {
         PrimarySampleSampler::new(key, self.settings.large_step, self.settings.mutation)
     }
 
+    /// Evaluates `bootstrap` independent points per stratum, keyed by (seed, `key`, index),
+    /// and returns `keep` of each (its contributions) in index order; adds their rays to the
+    /// counts. Each point's numbers come from its own key, so the order of evaluation does
+    /// not matter.
+    fn independent_points<R: Send>(
+        &mut self,
+        scene: &Scene,
+        key: u64,
+        keep: impl Fn(&Contributions) -> R + Sync,
+    ) -> Vec<R> {
+        let n = self.settings.bootstrap as u64;
+        let (seed, this) = (self.seed, &*self);
+        let evaluated: Vec<(R, u64)> = (0..self.target.strata() as u64 * n)
+            .into_par_iter()
+            .map_init(
+                || (T::Scratch::default(), Contributions::default()),
+                |(scratch, out), j| {
+                    let mut sampler = this.sampler(&[seed, key, j]);
+                    let stratum = (j / n) as usize;
+                    let e = this
+                        .target
+                        .evaluate(scene, &mut sampler, Some(stratum), scratch, out);
+                    (keep(out), e.rays)
+                },
+            )
+            .collect();
+        self.stats.rays += evaluated.iter().map(|e| e.1).sum::<u64>();
+        evaluated.into_iter().map(|e| e.0).collect()
+    }
+
     /// `importance=relative`'s pilot: `bootstrap` independent points per stratum of their
     /// own (not the bootstrap's: b must be estimated from points the pilot did not see, or
     /// the blocks where the pilot found no light, whose importance is largest, would be
     /// missing from b by construction and the image would come out too dark).
     fn make_pilot(&mut self, scene: &Scene) {
-        let strata = self.target.strata();
+        let entries = self.independent_points(scene, PILOT_KEY, |out| {
+            let entries = out.entries.iter();
+            let entries = entries.map(|&(raster, v)| (raster, v.luminance() as f64));
+            entries.collect::<Vec<(Vec2, f64)>>()
+        });
         let n = self.settings.bootstrap as u64;
-        let seed = self.seed;
-        let this = &*self;
-        let evaluated: Vec<(Vec<(Vec2, f64)>, u64)> = (0..strata as u64 * n)
-            .into_par_iter()
-            .map_init(
-                || (T::Scratch::default(), Contributions::default()),
-                |(scratch, out), j| {
-                    let mut sampler = this.sampler(&[seed, PILOT_KEY, j]);
-                    let stratum = (j / n) as usize;
-                    let e = this
-                        .target
-                        .evaluate(scene, &mut sampler, Some(stratum), scratch, out);
-                    let entries = out.entries.iter();
-                    let entries = entries.map(|&(raster, v)| (raster, v.luminance() as f64));
-                    (entries.collect(), e.rays)
-                },
-            )
-            .collect();
-        self.stats.rays += evaluated.iter().map(|e| e.1).sum::<u64>();
         let (width, height) = (self.film.width(), self.film.height());
-        let all = evaluated.iter().flat_map(|e| e.0.iter().copied());
-        self.pilot = Some(PilotMap::new(width, height, strata as u64 * n, n, all));
+        let all = entries.iter().flatten().copied();
+        self.pilot = Some(PilotMap::new(width, height, entries.len() as u64, n, all));
     }
 
     /// The bootstrap (after the pilot, with `importance=relative`), then the chains' first
@@ -268,28 +283,13 @@ impl<T: PathTarget> Metropolis<T> {
         let strata = self.target.strata();
         let n = self.settings.bootstrap as u64;
         let seed = self.seed;
-        let this = &*self;
-        // Importance of every bootstrap point, stratum by stratum; each point's numbers
-        // come from its own key, so the order of evaluation does not matter.
-        let evaluated: Vec<(f32, u64)> = (0..strata as u64 * n)
-            .into_par_iter()
-            .map_init(
-                || (T::Scratch::default(), Contributions::default()),
-                |(scratch, out), j| {
-                    let mut sampler = this.sampler(&[seed, BOOTSTRAP_KEY, j]);
-                    let stratum = (j / n) as usize;
-                    let e = this
-                        .target
-                        .evaluate(scene, &mut sampler, Some(stratum), scratch, out);
-                    if let Some(map) = &this.pilot {
-                        out.luminance = map.importance(out);
-                    }
-                    (out.luminance as f32, e.rays)
-                },
-            )
-            .collect();
-        self.stats.rays += evaluated.iter().map(|e| e.1).sum::<u64>();
-        let importance: Vec<f32> = evaluated.into_iter().map(|e| e.0).collect();
+        // Importance of every bootstrap point, stratum by stratum.
+        let pilot = self.pilot.clone();
+        let importance: Vec<f32> =
+            self.independent_points(scene, BOOTSTRAP_KEY, |out| match &pilot {
+                Some(map) => map.importance(out) as f32,
+                None => out.luminance as f32,
+            });
         let bootstrap = Bootstrap::new(&importance, strata, n);
         self.target.set_stratum_means(&bootstrap.stratum_means);
         if !(bootstrap.b > 0.0 && bootstrap.b.is_finite()) {
