@@ -24,15 +24,19 @@ use crate::error::{Error, Location, Result};
 use crate::io::exr::read_exr;
 use crate::light::distribution::Distribution2D;
 use crate::light::{EmissionSample, LightSample, SceneSphere};
+use crate::math::lanes::Real;
 use crate::math::{PI, Rgb, Transform, fast_trig};
+
+mod lanes;
 
 #[derive(Clone, Debug, PartialEq)]
 pub struct EnvmapLight {
     pub filename: PathBuf,
     width: usize,
     height: usize,
-    /// Radiance (texel × scale), row-major, row 0 at the zenith.
-    texels: Vec<Rgb>,
+    /// Radiance (texel × scale), row-major, row 0 at the zenith, three channels per texel
+    /// (flat, so that lanes can gather them).
+    channels: Vec<f32>,
     to_world: Mat3,
     to_local: Mat3,
     /// cos θ of each texel row: cos(π j / (H − 1)).
@@ -164,7 +168,7 @@ impl EnvmapLight {
             filename: filename.to_path_buf(),
             width,
             height,
-            texels,
+            channels: texels.iter().flat_map(|t| t.0).collect(),
             to_world: linear,
             to_local,
             cos_rows,
@@ -203,14 +207,36 @@ impl EnvmapLight {
     /// The texel column coordinate x = u·W − ½ in [0, W) of unit local direction `d`
     /// (u = atan2(d.x, −d.z)/2π, wrapped around).
     fn column_coordinate(&self, d: Vec3) -> f32 {
-        let u = fast_trig::atan2(d.x, -d.z) * (0.5 / PI);
-        (u * self.width as f32 - 0.5).rem_euclid(self.width as f32)
+        self.column_of(d.x, d.z)
+    }
+
+    /// `column_coordinate` from the direction's x and z, over `Real` (one direction, or
+    /// sixteen in lanes).
+    #[inline(always)]
+    fn column_of<T: Real>(&self, x: T, z: T) -> T {
+        let u = fast_trig::atan2(x, -z) * T::splat(0.5 / PI);
+        let w = T::splat(self.width as f32);
+        let x = u * w - T::splat(0.5);
+        // u is in [−½, ½], so x is in (−W, W), where `x.rem_euclid(W)` is this one add,
+        // bit for bit (the remainder of |x| < W is x itself).
+        T::select(x.lt(T::splat(0.0)), x + w, x)
     }
 
     /// The texel row coordinate y = v·(H − 1) of a direction with cos θ = `cos`
-    /// (v = acos(cos θ)/π).
-    fn row_coordinate(&self, cos: f32) -> f32 {
-        fast_trig::acos(cos) / PI * (self.height - 1) as f32
+    /// (v = acos(cos θ)/π), over `Real`.
+    #[inline(always)]
+    fn row_coordinate<T: Real>(&self, cos: T) -> T {
+        fast_trig::acos(cos) / T::splat(PI) * T::splat((self.height - 1) as f32)
+    }
+
+    /// Texel `k` (row-major index).
+    #[inline(always)]
+    fn texel(&self, k: usize) -> Rgb {
+        Rgb([
+            self.channels[3 * k],
+            self.channels[3 * k + 1],
+            self.channels[3 * k + 2],
+        ])
     }
 
     /// The bilinear interpolation at texel coordinates (x, y): x in [0, W] from texel
@@ -221,8 +247,8 @@ impl EnvmapLight {
         let j0 = (y as usize).min(h - 2);
         let fx = (x - i0 as f32).clamp(0.0, 1.0);
         let fy = (y - j0 as f32).clamp(0.0, 1.0);
-        let i1 = (i0 + 1) % w;
-        let t = |i: usize, j: usize| self.texels[j * w + i];
+        let i1 = if i0 + 1 == w { 0 } else { i0 + 1 };
+        let t = |i: usize, j: usize| self.texel(j * w + i);
         let top = t(i0, j0) * (1.0 - fx) + t(i1, j0) * fx;
         let bottom = t(i0, j0 + 1) * (1.0 - fx) + t(i1, j0 + 1) * fx;
         top * (1.0 - fy) + bottom * fy

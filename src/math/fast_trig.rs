@@ -5,6 +5,8 @@
 
 use std::f32::consts::{FRAC_PI_2, PI};
 
+use crate::math::lanes::Real;
+
 /// Coefficients of atan x ≈ x·(1 + a₂x² + a₄x⁴ + … + a₁₆x¹⁶) on 0 ≤ x ≤ 1, with absolute
 /// error at most 2·10⁻⁸ (Abramowitz and Stegun 1964, eq. 4.4.49).
 const ATAN: [f32; 8] = [
@@ -19,37 +21,49 @@ const ATAN: [f32; 8] = [
 ];
 
 /// atan(a) for a in [0, 1].
-#[inline]
-fn atan_unit(a: f32) -> f32 {
+#[inline(always)]
+fn atan_unit<T: Real>(a: T) -> T {
     let a2 = a * a;
     // Horner's rule from the highest power.
-    let p = ATAN.iter().rev().fold(0.0f32, |acc, &c| acc * a2 + c);
+    let p = ATAN
+        .iter()
+        .rev()
+        .fold(T::splat(0.0), |acc, &c| acc * a2 + T::splat(c));
     a + a * a2 * p
 }
 
-/// atan2(y, x) in [−π, π], as `f32::atan2` for every sign of y and x (zeros included):
-/// the angle of (x, y) from the +x axis. atan2(0, 0) is 0 (or ±π for x = −0).
-#[inline]
-pub fn atan2(y: f32, x: f32) -> f32 {
-    let (ax, ay) = (x.abs(), y.abs());
-    let (lo, hi) = if ax < ay { (ax, ay) } else { (ay, ax) };
-    // The octant's angle from the nearer axis.
-    let mut r = if hi > 0.0 { atan_unit(lo / hi) } else { 0.0 };
-    if ay > ax {
-        r = FRAC_PI_2 - r;
-    }
-    if x.is_sign_negative() {
-        r = PI - r;
-    }
-    if y.is_sign_negative() { -r } else { r }
+/// True where the sign bit of `x` is set (−0 and NaNs with the sign bit included), as
+/// `f32::is_sign_negative`.
+#[inline(always)]
+fn sign_negative<T: Real>(x: T) -> T::Mask {
+    T::splat(1.0).copysign(x).lt(T::splat(0.0))
 }
 
-/// acos(x) in [0, π] for x in [−1, 1] (clamped): the angle whose cosine is x, through
-/// atan2(√((1 − x)(1 + x)), x), which keeps its precision near ±1.
-#[inline]
-pub fn acos(x: f32) -> f32 {
-    let x = x.clamp(-1.0, 1.0);
-    atan2(((1.0 - x) * (1.0 + x)).sqrt(), x)
+/// atan2(y, x) in [−π, π], as `f32::atan2` for every sign of y and x (zeros included):
+/// the angle of (x, y) from the +x axis. atan2(0, 0) is 0 (or ±π for x = −0). Written
+/// against `Real`, so sixteen lanes give each lane the bits of the scalar call.
+#[inline(always)]
+pub fn atan2<T: Real>(y: T, x: T) -> T {
+    let (ax, ay) = (x.abs(), y.abs());
+    let y_larger = ax.lt(ay);
+    let (lo, hi) = (T::select(y_larger, ax, ay), T::select(y_larger, ay, ax));
+    // The octant's angle from the nearer axis (0 at the origin, where lo / hi is 0 / 0).
+    let zero = T::splat(0.0);
+    let mut r = T::select(hi.gt(zero), atan_unit(lo / hi), zero);
+    r = T::select(ay.gt(ax), T::splat(FRAC_PI_2) - r, r);
+    r = T::select(sign_negative(x), T::splat(PI) - r, r);
+    T::select(sign_negative(y), -r, r)
+}
+
+/// acos(x) in [0, π] for x in [−1, 1] (clamped): the angle whose cosine is
+/// x, through atan2(√((1 − x)(1 + x)), x), which keeps its precision near ±1.
+#[inline(always)]
+pub fn acos<T: Real>(x: T) -> T {
+    let one = T::splat(1.0);
+    // `f32::clamp(−1, 1)`.
+    let x = T::select(x.lt(-one), -one, x);
+    let x = T::select(x.gt(one), one, x);
+    atan2(((one - x) * (one + x)).sqrt(), x)
 }
 
 #[cfg(test)]
@@ -93,5 +107,40 @@ mod tests {
         assert_eq!(acos(-1.0), PI);
         assert_eq!(acos(1.5), 0.0);
         assert_eq!(acos(0.0), FRAC_PI_2);
+    }
+
+    /// Sixteen lanes give each lane the scalar call's bits, on values around the circle,
+    /// signed zeros, infinities and NaNs.
+    #[test]
+    fn lanes_give_the_scalar_bits() {
+        use crate::math::lanes::F32x16;
+        let special = [
+            0.0f32,
+            -0.0,
+            1.0,
+            -1.0,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        let mut values: Vec<f32> = special.to_vec();
+        values.extend((0..1000).map(|k| ((k as f32) * 0.7311).sin() * 1.3));
+        let same = |a: f32, b: f32| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+        for (k, chunk) in values.chunks(16).enumerate() {
+            let ys: [f32; 16] = std::array::from_fn(|i| chunk.get(i).copied().unwrap_or(0.5));
+            let xs: [f32; 16] =
+                std::array::from_fn(|i| values[(k * 16 + i * 7 + 3) % values.len()]);
+            let got = atan2(F32x16::from_array(ys), F32x16::from_array(xs)).to_array();
+            let got_acos = acos(F32x16::from_array(ys)).to_array();
+            for i in 0..16 {
+                assert!(
+                    same(got[i], atan2(ys[i], xs[i])),
+                    "atan2({}, {})",
+                    ys[i],
+                    xs[i]
+                );
+                assert!(same(got_acos[i], acos(ys[i])), "acos({})", ys[i]);
+            }
+        }
     }
 }

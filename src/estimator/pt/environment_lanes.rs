@@ -17,8 +17,7 @@ impl PathSample {
     /// Adds, for the lanes of `m` (rays that escaped, the environment shown), what `arrive`
     /// adds there: for each light at infinity in turn, throughput × Le × w, queued in order
     /// with the shadow rays (`ShadowQueue`, a term without a ray). A `constant` light's
-    /// radiance and density are the same in every lane; an `envmap` is looked up lane by
-    /// lane.
+    /// radiance and density are the same in every lane; an `envmap` is looked up in lanes.
     pub(super) fn environment_in_lanes(
         &self,
         scene: &Scene,
@@ -51,6 +50,7 @@ impl PathSample {
                     );
                     (le, F32x16::splat(pdf))
                 }
+                Light::Envmap(e) => e.le_and_pdf_lanes(towards_light, m, weighted),
                 _ => {
                     let (mut le, mut pdf) = (V3::new(zero, zero, zero), zero);
                     for i in m.lanes() {

@@ -52,6 +52,7 @@ binary_ops!(F32x16,
 binary_ops!(U32x16,
     Add add _mm512_add_epi32,
     Sub sub _mm512_sub_epi32,
+    Mul mul _mm512_mullo_epi32,
     BitAnd bitand _mm512_and_si512,
     BitOr bitor _mm512_or_si512,
     BitXor bitxor _mm512_xor_si512,
@@ -251,6 +252,15 @@ impl F32x16 {
             let both = _mm512_insertf64x4::<1>(_mm512_castpd256_pd512(lo), hi);
             F32x16(_mm512_castpd_ps(both))
         }
+    }
+
+    /// Each lane `as u32`: towards zero, NaN and negatives to 0, saturating at u32::MAX.
+    #[inline(always)]
+    pub fn to_u32(self) -> U32x16 {
+        // The maximum with +0 sends NaN and negatives to 0; the unsigned truncation gives
+        // u32::MAX for anything above it (its out-of-range value), as `as u32` saturates.
+        let v = self.max_gt(F32x16::splat(0.0));
+        U32x16(unsafe { _mm512_cvttps_epu32(v.0) })
     }
 }
 

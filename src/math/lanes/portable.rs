@@ -50,6 +50,7 @@ binary_ops!(F32x16, 16,
 binary_ops!(U32x16, 16,
     Add add |a: u32, b: u32| a.wrapping_add(b),
     Sub sub |a: u32, b: u32| a.wrapping_sub(b),
+    Mul mul |a: u32, b: u32| a.wrapping_mul(b),
     BitAnd bitand |a: u32, b: u32| a & b,
     BitOr bitor |a: u32, b: u32| a | b,
     BitXor bitxor |a: u32, b: u32| a ^ b,
@@ -238,6 +239,12 @@ impl F32x16 {
                 hi.0[i - 8] as f32
             }
         }))
+    }
+
+    /// Each lane `as u32`: towards zero, NaN and negatives to 0, saturating at u32::MAX.
+    #[inline(always)]
+    pub fn to_u32(self) -> U32x16 {
+        U32x16(self.0.map(|v| v as u32))
     }
 }
 

@@ -160,6 +160,12 @@ fn lane_conversions_equal_scalar_ones() {
         for i in 0..16 {
             assert_eq!(x.is_nan().get(i), a[i].is_nan());
         }
+        assert_eq!(x.to_u32().to_array(), a.map(|v| v as u32), "to_u32");
+        assert_eq!(
+            portable::F32x16(a).to_u32().0,
+            a.map(|v| v as u32),
+            "to_u32 (portable)"
+        );
         let (lo, hi) = x.to_f64_halves();
         let (lo, hi) = (lo.to_array(), hi.to_array());
         for i in 0..16 {
@@ -244,6 +250,10 @@ fn integer_lane_operations_equal_scalar_ones() {
         assert_eq!(x.shl::<3>().to_array(), a.map(|v| v << 3));
         assert_eq!(x.shr::<5>().to_array(), a.map(|v| v >> 5));
         assert_eq!(x.to_f32().to_array(), a.map(|v| v as f32));
+        assert_eq!(
+            (x * y).to_array(),
+            std::array::from_fn(|i| a[i].wrapping_mul(b[i]))
+        );
         assert_eq!(x.min(y).to_array(), std::array::from_fn(|i| a[i].min(b[i])));
         let (lo, hi) = x.to_u64_halves();
         let wide: Vec<u64> = lo.to_array().into_iter().chain(hi.to_array()).collect();
