@@ -102,6 +102,7 @@ impl AreaLight {
             pdf_solid_angle: s.pdf_solid_angle,
             pdf_area: s.pdf_area,
             delta: false,
+            at_infinity: false,
         })
     }
 

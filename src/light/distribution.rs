@@ -118,46 +118,23 @@ impl Distribution1D {
         self.sum
     }
 
-    /// The item whose cdf interval [cdf[i], cdf[i+1]) holds `u`. Never an item of weight 0
-    /// (its interval is empty).
-    fn find(&self, u: f64) -> usize {
-        // Largest i with cdf[i] <= u, among 0..n: the number of cdf entries <= u, minus one
-        // (the cdf does not decrease). A few items (a light's triangles, a scene's lights)
-        // are counted without branches: a binary search there mispredicts half its steps.
-        let n = self.func.len();
-        let i = if n <= SMALL {
-            self.cdf.iter().map(|&c| (c <= u) as usize).sum()
-        } else {
-            // The count of entries ≤ u, walked to from the guide's start for u's bucket:
-            // exact whatever the rounding of the bucket's index, and a step or two on
-            // average (a binary search over an environment map's rows and columns was
-            // 6% of `pt`'s time there).
-            let bucket = ((u * n as f64) as usize).min(n - 1);
-            let mut i = self.guide[bucket] as usize;
-            while i > 0 && self.cdf[i - 1] > u {
-                i -= 1;
-            }
-            while i < self.cdf.len() && self.cdf[i] <= u {
-                i += 1;
-            }
-            i
-        };
-        i.saturating_sub(1).min(n - 1)
+    /// This distribution as a `Row` (what sampling reads).
+    #[inline(always)]
+    fn row(&self) -> Row<'_> {
+        Row {
+            cdf: &self.cdf,
+            guide: &self.guide,
+            func: &self.func,
+            sum: self.sum,
+        }
     }
 
     /// Draws an item: (index, its probability, `u` rescaled to [0, 1) within the item's cdf
     /// interval, fresh for reuse).
     pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
-        let u = (u.clamp(0.0, ONE_MINUS_EPSILON)) as f64;
-        let i = self.find(u);
-        let width = self.cdf[i + 1] - self.cdf[i];
-        let remapped = if width > 0.0 {
-            ((u - self.cdf[i]) / width) as f32
-        } else {
-            0.0
-        };
+        let (i, remapped) = self.row().sample_discrete(u);
         // The probability as `pmf` computes it, so MIS weights see identical values.
-        (i, self.pmf(i), remapped.clamp(0.0, ONE_MINUS_EPSILON))
+        (i, self.pmf(i), remapped)
     }
 
     /// `sample_discrete` for the lanes of `m`, lane by lane the same bits (other lanes:
@@ -253,15 +230,25 @@ impl Distribution1D {
 
     /// Draws x in [0, 1) with the step density: (x, density at x, interval index).
     pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
-        let (i, _, du) = self.sample_discrete(u);
-        let n = self.func.len();
-        let x = ((i as f32 + du) / n as f32).min(ONE_MINUS_EPSILON);
-        (x, self.density(i), i)
+        self.row().sample_continuous(u)
+    }
+
+    /// `sample_continuous` for the lanes of `m`: (x, interval index), lane by lane the
+    /// scalar bits (other lanes: 0).
+    #[inline]
+    pub fn sample_continuous_lanes(&self, u: F32x16, m: Mask16) -> (F32x16, U32x16) {
+        let zero = U32x16::splat(0);
+        let rows = StackedRows {
+            cdf: &self.cdf,
+            guide: &self.guide,
+            n: self.func.len(),
+        };
+        rows.sample_continuous_lanes(zero, zero, u, m)
     }
 
     /// The density of interval `i`: n · weight_i / Σ weight.
     fn density(&self, i: usize) -> f32 {
-        (self.func[i] as f64 * self.func.len() as f64 / self.sum) as f32
+        self.row().density(i)
     }
 
     /// The density at x (0 outside [0, 1)).
@@ -275,14 +262,205 @@ impl Distribution1D {
     }
 }
 
+/// One distribution over n items as `find` and sampling read it: its cdf (n + 1 entries),
+/// its guide table (n entries, none for at most `SMALL` items), its weights and their sum.
+/// `Distribution1D` is one; `Distribution2D` keeps its rows' side by side.
+#[derive(Clone, Copy)]
+struct Row<'a> {
+    cdf: &'a [f64],
+    guide: &'a [u32],
+    func: &'a [f32],
+    sum: f64,
+}
+
+impl Row<'_> {
+    /// The item whose cdf interval [cdf[i], cdf[i+1]) holds `u`. Never an item of weight 0
+    /// (its interval is empty).
+    #[inline(always)]
+    fn find(&self, u: f64) -> usize {
+        // Largest i with cdf[i] <= u, among 0..n: the number of cdf entries <= u, minus one
+        // (the cdf does not decrease). A few items (a light's triangles, a scene's lights)
+        // are counted without branches: a binary search there mispredicts half its steps.
+        let n = self.func.len();
+        let i = if n <= SMALL {
+            self.cdf.iter().map(|&c| (c <= u) as usize).sum()
+        } else {
+            // The count of entries ≤ u, walked to from the guide's start for u's bucket:
+            // exact whatever the rounding of the bucket's index, and a step or two on
+            // average (a binary search over an environment map's rows and columns was
+            // 6% of `pt`'s time there).
+            let bucket = ((u * n as f64) as usize).min(n - 1);
+            let mut i = self.guide[bucket] as usize;
+            while i > 0 && self.cdf[i - 1] > u {
+                i -= 1;
+            }
+            while i < self.cdf.len() && self.cdf[i] <= u {
+                i += 1;
+            }
+            i
+        };
+        i.saturating_sub(1).min(n - 1)
+    }
+
+    /// Draws an item: (index, `u` rescaled to [0, 1) within the item's cdf interval).
+    #[inline(always)]
+    fn sample_discrete(&self, u: f32) -> (usize, f32) {
+        let u = (u.clamp(0.0, ONE_MINUS_EPSILON)) as f64;
+        let i = self.find(u);
+        let width = self.cdf[i + 1] - self.cdf[i];
+        let remapped = if width > 0.0 {
+            ((u - self.cdf[i]) / width) as f32
+        } else {
+            0.0
+        };
+        (i, remapped.clamp(0.0, ONE_MINUS_EPSILON))
+    }
+
+    /// Draws x in [0, 1) with the step density: (x, density at x, interval index).
+    #[inline(always)]
+    fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
+        let (i, du) = self.sample_discrete(u);
+        let n = self.func.len();
+        let x = ((i as f32 + du) / n as f32).min(ONE_MINUS_EPSILON);
+        (x, self.density(i), i)
+    }
+
+    /// The density of interval `i`: n · weight_i / Σ weight.
+    #[inline(always)]
+    fn density(&self, i: usize) -> f32 {
+        (self.func[i] as f64 * self.func.len() as f64 / self.sum) as f32
+    }
+}
+
+/// Rows of n items each side by side, as `Row::sample_continuous` reads them, for lanes
+/// that each sample their own row: a row's cdf starts at a multiple of n + 1 in `cdf`, its
+/// guide at a multiple of n in `guide`.
+struct StackedRows<'a> {
+    cdf: &'a [f64],
+    guide: &'a [u32],
+    n: usize,
+}
+
+impl StackedRows<'_> {
+    /// `Row::sample_continuous` per lane of `m`, lane i in the row whose cdf starts at
+    /// `cdf_start[i]` and guide at `guide_start[i]`: (x, interval index), the scalar bits
+    /// (other lanes: 0).
+    #[inline(always)]
+    fn sample_continuous_lanes(
+        &self,
+        cdf_start: U32x16,
+        guide_start: U32x16,
+        u: F32x16,
+        m: Mask16,
+    ) -> (F32x16, U32x16) {
+        let u = clamp_unit(u);
+        let (u_lo, u_hi) = u.to_f64_halves();
+        let i = self.find_lanes(cdf_start, guide_start, u, (u_lo, u_hi), m);
+        // `Row::sample_discrete`'s remapping within the item's interval.
+        let (lo_lo, lo_hi) = self.cdf_at(cdf_start + i, m);
+        let (hi_lo, hi_hi) = self.cdf_at(cdf_start + i + U32x16::splat(1), m);
+        let zero = F64x8::splat(0.0);
+        let remap = |u: F64x8, lo: F64x8, hi: F64x8| {
+            let width = hi - lo;
+            let positive = width.gt(zero);
+            (F64x8::select(positive, (u - lo) / width, zero), positive)
+        };
+        let (r_lo, pos_lo) = remap(u_lo, lo_lo, hi_lo);
+        let (r_hi, pos_hi) = remap(u_hi, lo_hi, hi_hi);
+        let du = F32x16::select(
+            Mask16::from_halves(pos_lo, pos_hi),
+            F32x16::from_f64_halves(r_lo, r_hi),
+            F32x16::splat(0.0),
+        );
+        let du = clamp_unit(du);
+        // `Row::sample_continuous`'s x.
+        let n = F32x16::splat(self.n as f32);
+        let x = ((i.to_f32() + du) / n).min_lt(F32x16::splat(ONE_MINUS_EPSILON));
+        (
+            F32x16::select(m, x, F32x16::splat(0.0)),
+            U32x16::select(m, i, U32x16::splat(0)),
+        )
+    }
+
+    /// `Row::find` per lane for `u` (clamped, in f32 and in f64 halves).
+    #[inline(always)]
+    fn find_lanes(
+        &self,
+        cdf_start: U32x16,
+        guide_start: U32x16,
+        u: F32x16,
+        (u_lo, u_hi): (F64x8, F64x8),
+        m: Mask16,
+    ) -> U32x16 {
+        let n = self.n as u32;
+        let one = U32x16::splat(1);
+        let at_most_u = |lo: F64x8, hi: F64x8| Mask16::from_halves(lo.le(u_lo), hi.le(u_hi));
+        let above_u = |lo: F64x8, hi: F64x8| Mask16::from_halves(lo.gt(u_lo), hi.gt(u_hi));
+        let count = if self.n <= SMALL {
+            // Every entry counted, as the scalar code counts them.
+            let mut count = U32x16::splat(0);
+            for k in 0..=n {
+                let (lo, hi) = self.cdf_at(cdf_start + U32x16::splat(k), m);
+                count = count + U32x16::select(at_most_u(lo, hi), one, U32x16::splat(0));
+            }
+            count
+        } else {
+            // The walk from the guide's bucket. The bucket is found in f32 here, where the
+            // scalar code uses f64: the walk ends at the same count from any start.
+            let bucket = (u * F32x16::splat(self.n as f32))
+                .to_u32()
+                .min(U32x16::splat(n - 1));
+            let mut i = U32x16::gather(self.guide, guide_start + bucket, m);
+            loop {
+                let previous = i - one;
+                let (lo, hi) = self.cdf_at(cdf_start + previous, m);
+                let down = m & !i.eq(U32x16::splat(0)) & above_u(lo, hi);
+                if down.none() {
+                    break;
+                }
+                i = U32x16::select(down, previous, i);
+            }
+            loop {
+                let (lo, hi) = self.cdf_at(cdf_start + i, m);
+                let up = m & i.lt(U32x16::splat(n + 1)) & at_most_u(lo, hi);
+                if up.none() {
+                    break;
+                }
+                i = U32x16::select(up, i + one, i);
+            }
+            i
+        };
+        // count.saturating_sub(1).min(n − 1)
+        let index = U32x16::select(count.eq(U32x16::splat(0)), count, count - one);
+        index.min(U32x16::splat(n - 1))
+    }
+
+    /// cdf[idx] in the lanes of `m`, as f64 halves (lanes 0–7, 8–15).
+    #[inline(always)]
+    fn cdf_at(&self, idx: U32x16, m: Mask16) -> (F64x8, F64x8) {
+        let (idx_lo, idx_hi) = idx.to_u64_halves();
+        let (m_lo, m_hi) = m.halves();
+        (
+            F64x8::gather(self.cdf, idx_lo, m_lo),
+            F64x8::gather(self.cdf, idx_hi, m_hi),
+        )
+    }
+}
+
 /// A piecewise-constant density on [0, 1)² over an `nu` × `nv` grid of cells (row-major,
 /// row index along v), proportional to the cell weights.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Distribution2D {
-    /// One distribution over u per row (uniform for rows of zero weight, never drawn).
-    conditional: Vec<Distribution1D>,
     /// Over rows, by row sums.
     marginal: Distribution1D,
+    /// Each row's distribution over u, side by side (`StackedRows`): row v's cdf is
+    /// `row_cdf[v·(nu + 1)..][..nu + 1]`, its guide `row_guide[v·nu..][..nu]` (none for
+    /// nu ≤ `SMALL`), its weights `row_func[v·nu..][..nu]`, their sum `row_sum[v]`. A row of
+    /// zero weight holds a uniform distribution (never drawn).
+    row_cdf: Vec<f64>,
+    row_guide: Vec<u32>,
+    row_func: Vec<f32>,
+    row_sum: Vec<f64>,
     nu: usize,
     nv: usize,
 }
@@ -297,24 +475,30 @@ impl Distribution2D {
         if weights.iter().any(|w| !(w.is_finite() && *w >= 0.0)) {
             return None;
         }
-        let mut conditional = Vec::with_capacity(nv);
         let mut row_sums = Vec::with_capacity(nv);
+        let (mut row_cdf, mut row_guide) = (Vec::new(), Vec::new());
+        let (mut row_func, mut row_sum) = (Vec::with_capacity(nu * nv), Vec::with_capacity(nv));
         for row in weights.chunks_exact(nu) {
-            match Distribution1D::new(row) {
+            let (d, sum) = match Distribution1D::new(row) {
                 Some(d) => {
-                    row_sums.push(d.sum() as f32);
-                    conditional.push(d);
+                    let sum = d.sum() as f32;
+                    (d, sum)
                 }
-                None => {
-                    row_sums.push(0.0);
-                    conditional.push(Distribution1D::uniform(nu));
-                }
-            }
+                None => (Distribution1D::uniform(nu), 0.0),
+            };
+            row_sums.push(sum);
+            row_cdf.extend_from_slice(&d.cdf);
+            row_guide.extend_from_slice(&d.guide);
+            row_func.extend_from_slice(&d.func);
+            row_sum.push(d.sum);
         }
         let marginal = Distribution1D::new(&row_sums)?;
         Some(Distribution2D {
-            conditional,
             marginal,
+            row_cdf,
+            row_guide,
+            row_func,
+            row_sum,
             nu,
             nv,
         })
@@ -324,12 +508,49 @@ impl Distribution2D {
         (self.nu, self.nv)
     }
 
+    /// Row `v`'s distribution over u.
+    #[inline(always)]
+    fn row(&self, v: usize) -> Row<'_> {
+        let guide = if self.row_guide.is_empty() {
+            &self.row_guide[..]
+        } else {
+            &self.row_guide[v * self.nu..][..self.nu]
+        };
+        Row {
+            cdf: &self.row_cdf[v * (self.nu + 1)..][..self.nu + 1],
+            guide,
+            func: &self.row_func[v * self.nu..][..self.nu],
+            sum: self.row_sum[v],
+        }
+    }
+
     /// Draws (u, v) in [0, 1)²: the row by the marginal with `u.y`, then u within the row
     /// with `u.x`. Returns the point, its density on [0, 1)² and the cell (iu, iv).
     pub fn sample(&self, u: Vec2) -> (Vec2, f32, [usize; 2]) {
         let (v, pdf_v, iv) = self.marginal.sample_continuous(u.y);
-        let (x, pdf_u, iu) = self.conditional[iv].sample_continuous(u.x);
+        let (x, pdf_u, iu) = self.row(iv).sample_continuous(u.x);
         (Vec2::new(x, v), pdf_v * pdf_u, [iu, iv])
+    }
+
+    /// `sample` for the lanes of `m`, without the density: (u, v, iu, iv), lane by lane
+    /// the scalar bits (other lanes: 0).
+    #[inline]
+    pub fn sample_lanes(
+        &self,
+        ux: F32x16,
+        uy: F32x16,
+        m: Mask16,
+    ) -> (F32x16, F32x16, U32x16, U32x16) {
+        let (v, iv) = self.marginal.sample_continuous_lanes(uy, m);
+        let rows = StackedRows {
+            cdf: &self.row_cdf,
+            guide: &self.row_guide,
+            n: self.nu,
+        };
+        let nu = self.nu as u32;
+        let (x, iu) =
+            rows.sample_continuous_lanes(iv * U32x16::splat(nu + 1), iv * U32x16::splat(nu), ux, m);
+        (x, v, iu, iv)
     }
 
     /// The density at (u, v) (0 outside [0, 1)²).
@@ -344,7 +565,7 @@ impl Distribution2D {
 
     /// The density in cell (iu, iv): nu · nv · weight / Σ weights.
     pub fn cell_pdf(&self, iu: usize, iv: usize) -> f32 {
-        let w = self.conditional[iv].weight(iu) as f64;
+        let w = self.row_func[iv * self.nu + iu] as f64;
         if self.marginal.weight(iv) == 0.0 {
             return 0.0;
         }
@@ -409,6 +630,56 @@ mod tests {
                         w.len(),
                         u[i]
                     );
+                }
+            }
+        }
+    }
+
+    /// `Distribution2D::sample_lanes` gives each lane the cell and point of `sample`, on
+    /// grids with few and many cells per row and rows (counted and walked finds), rows and
+    /// cells of zero weight, and u at 0, just below 1, 1 and NaN; masked lanes read 0.
+    #[test]
+    fn two_d_lanes_sample_as_the_scalar_code_does() {
+        let grids: [(usize, usize); 5] = [(1, 1), (2, 3), (16, 17), (40, 5), (33, 70)];
+        let mut s = 0x9E37_79B9_7F4A_7C15u64;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for (nu, nv) in grids {
+            let weights: Vec<f32> = (0..nu * nv)
+                .map(|k| match (k / nu % 4, k % 7) {
+                    (1, _) if nv > 2 => 0.0, // whole rows of zero weight
+                    (_, 3) => 0.0,
+                    _ => 0.1 + next() * next() * 40.0,
+                })
+                .collect();
+            let d = Distribution2D::new(&weights, nu, nv).unwrap();
+            for round in 0..500 {
+                let special = |k: usize, v: f32| match k % 9 {
+                    0 => 0.0,
+                    1 => ONE_MINUS_EPSILON,
+                    2 => 1.0,
+                    3 if round == 7 => f32::NAN,
+                    _ => v,
+                };
+                let ux: [f32; 16] = std::array::from_fn(|i| special(round + i, next()));
+                let uy: [f32; 16] = std::array::from_fn(|i| special(round + 2 * i + 1, next()));
+                let m = Mask16(0xffff ^ (1 << (round % 16)));
+                let (x, v, iu, iv) =
+                    d.sample_lanes(F32x16::from_array(ux), F32x16::from_array(uy), m);
+                let (x, v, iu, iv) = (x.to_array(), v.to_array(), iu.to_array(), iv.to_array());
+                for i in 0..16 {
+                    let want = if m.get(i) {
+                        let (p, _, [a, b]) = d.sample(Vec2::new(ux[i], uy[i]));
+                        (p.x.to_bits(), p.y.to_bits(), a as u32, b as u32)
+                    } else {
+                        (0, 0, 0, 0)
+                    };
+                    let got = (x[i].to_bits(), v[i].to_bits(), iu[i], iv[i]);
+                    assert_eq!(got, want, "{nu}x{nv}, u ({}, {})", ux[i], uy[i]);
                 }
             }
         }
@@ -482,7 +753,7 @@ mod tests {
                     .partition_point(|&c| c <= u)
                     .saturating_sub(1)
                     .min(n - 1);
-                assert_eq!(d.find(u), expected, "n {n}, u {u}");
+                assert_eq!(d.row().find(u), expected, "n {n}, u {u}");
             }
         }
     }

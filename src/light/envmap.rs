@@ -25,7 +25,7 @@ use crate::io::exr::read_exr;
 use crate::light::distribution::Distribution2D;
 use crate::light::{EmissionSample, LightSample, SceneSphere};
 use crate::math::lanes::Real;
-use crate::math::{PI, Rgb, Transform, fast_trig};
+use crate::math::{PI, Rgb, Transform, fast_trig, warp};
 
 mod lanes;
 
@@ -274,7 +274,8 @@ impl EnvmapLight {
         let phi = 2.0 * PI * (x + 0.5) / self.width as f32;
         let cos = self.cos_rows[iv] + (self.cos_rows[iv + 1] - self.cos_rows[iv]) * fy;
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
-        let (sin_phi, cos_phi) = phi.sin_cos();
+        // Our own sine and cosine, which lanes reproduce (`lanes.rs`).
+        let (sin_phi, cos_phi) = warp::sin_cos_turns(phi);
         let local = Vec3::new(sin_phi * sin, cos, -cos_phi * sin);
         let wi = (self.to_world * local).normalize();
         let pdf = self.cell_density[iv * self.width + iu];

@@ -96,7 +96,7 @@ pub struct LightSample {
     pub delta: bool,
 }
 
-/// `LightSample`s of area and point lights in sixteen lanes (`Light::sample_li_lanes`): the
+/// `LightSample`s of area and point lights and environment maps in sixteen lanes (`Light::sample_li_lanes`): the
 /// lanes of `ok` have a sample. Their points lie at a finite distance, and their `front` is
 /// `n`.
 #[derive(Clone, Copy, Debug)]
@@ -111,6 +111,8 @@ pub struct LightSampleLanes {
     pub pdf_area: f32,
     /// A point light (a delta in position): `n`, `p_error` zero.
     pub delta: bool,
+    /// A light at infinity (`p` is the direction `wi`, at infinite distance).
+    pub at_infinity: bool,
 }
 
 /// What an area light sends towards rays that hit it, in sixteen lanes
@@ -447,7 +449,7 @@ impl Light {
 
     /// `sample_li` for the lanes of `m` (reference points `r`, 2D samples `ux`, `uy`),
     /// lane by lane the same bits; None for lights the lanes cannot sample (all but point
-    /// lights and area lights on meshes without vertex normals).
+    /// lights, environment maps and area lights on meshes without vertex normals).
     #[inline]
     pub fn sample_li_lanes(
         &self,
@@ -459,6 +461,7 @@ impl Light {
         let mut s = match self {
             Light::Area(l) => l.sample_li_lanes(r, ux, uy, m)?,
             Light::Point(l) => l.sample_li_lanes(r, m),
+            Light::Envmap(l) => l.sample_li_lanes(ux, uy, m)?,
             _ => return None,
         };
         // The checks of `sample_li`.

@@ -60,6 +60,7 @@ impl PointLight {
             pdf_solid_angle: c(1.0),
             pdf_area: 1.0,
             delta: true,
+            at_infinity: false,
         }
     }
 

@@ -77,7 +77,9 @@ impl NeeLanes {
             match light.sample_li_lanes(*p, u.0, u.1, same) {
                 Some(s) => {
                     out.ok |= s.ok;
-                    out.finite |= same;
+                    if !s.at_infinity {
+                        out.finite |= same;
+                    }
                     if s.delta {
                         out.delta |= same;
                     }

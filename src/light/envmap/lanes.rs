@@ -1,13 +1,17 @@
-//! The environment map looked up for sixteen directions at once: what rays that escaped
-//! the scene read from it (`le`) and the density with which next-event estimation would
-//! have drawn their directions (`pdf_direction`). Every step is the scalar code's step in
+//! The environment map for sixteen directions at once: what rays that escaped the scene
+//! read from it (`le`), the density with which next-event estimation would have drawn
+//! their directions (`pdf_direction`), and next-event estimation's own draws
+//! (`sample_li`). Every step is the scalar code's step in
 //! lanes (`Real` formulas, gathers for the texels, the row bands and the cell densities),
 //! so each lane holds the bits the scalar functions give.
 
 use glam::Mat3;
 
 use super::EnvmapLight;
+use crate::light::LightSampleLanes;
+use crate::math::PI;
 use crate::math::lanes::{F32x16, Mask16, U32x16, V3};
+use crate::math::warp;
 
 impl EnvmapLight {
     /// For world directions `wi` (towards the environment) in the lanes of `m`: the
@@ -45,6 +49,49 @@ impl EnvmapLight {
         // `Light::pdf_li`'s cleaning.
         let clean = pdf.is_finite() & pdf.gt(zero) & wanted;
         (le, F32x16::select(clean, pdf, zero))
+    }
+
+    /// `sample_li` (through `Light::sample_li`'s checks, which `Light::sample_li_lanes`
+    /// applies) for the lanes of `m`: a cell by the map's distribution, a direction uniform
+    /// in solid angle within it, its density and the radiance at its texel coordinates.
+    /// None for a black map (the scalar code draws nothing there either).
+    pub fn sample_li_lanes(&self, ux: F32x16, uy: F32x16, m: Mask16) -> Option<LightSampleLanes> {
+        let cells = self.cells.as_ref()?;
+        let zero = F32x16::splat(0.0);
+        // `sample_texel_direction`.
+        let (u, v, iu, iv) = cells.sample_lanes(ux, uy, m);
+        let (w, h) = (self.width as f32, self.height as f32);
+        let fx = clamp(u * F32x16::splat(w) - iu.to_f32(), 0.0, 1.0);
+        let fy = clamp(v * F32x16::splat(h - 1.0) - iv.to_f32(), 0.0, 1.0);
+        let x = iu.to_f32() + fx;
+        let phi = F32x16::splat(2.0 * PI) * (x + F32x16::splat(0.5)) / F32x16::splat(w);
+        let cos_top = F32x16::gather(&self.cos_rows, iv, m);
+        let cos_bottom = F32x16::gather(&self.cos_rows, iv + U32x16::splat(1), m);
+        let cos = cos_top + (cos_bottom - cos_top) * fy;
+        let sin = (F32x16::splat(1.0) - cos * cos).max_gt(zero).sqrt();
+        let (sin_phi, cos_phi) = warp::sin_cos_turns(phi);
+        let local = V3::new(sin_phi * sin, cos, -cos_phi * sin);
+        let wi = mul_mat3(&self.to_world, local).normalize();
+        let cell = iv * U32x16::splat(self.width as u32) + iu;
+        let pdf = F32x16::gather(&self.cell_density, cell, m);
+        let ok = m & pdf.gt(zero) & pdf.is_finite() & wi.is_finite();
+        // `sample_with_radiance`, then `LightSample::at_infinity`.
+        let radiance = self.bilinear_lanes(x, self.row_coordinate(cos), ok);
+        let zero3 = V3::splat(0.0);
+        Some(LightSampleLanes {
+            ok,
+            p: wi,
+            n: -wi,
+            p_error: zero3,
+            wi,
+            radiance,
+            pdf_solid_angle: pdf,
+            // Per lane the scalar sample's area density is its solid-angle density, whose
+            // checks cover it; the one value here only has to be finite.
+            pdf_area: 1.0,
+            delta: false,
+            at_infinity: true,
+        })
     }
 
     /// `bilinear` for texel coordinates (x, y) in the lanes of `m`.
@@ -183,6 +230,78 @@ mod tests {
             out.push(Vec3::new(r * phi.cos(), z, r * phi.sin()));
         }
         out
+    }
+
+    /// Each lane of `Light::sample_li_lanes` on an environment map holds the bits of
+    /// `Light::sample_li` (direction, radiance, density, whether there is a sample), on maps
+    /// of several sizes with black rows, u at the square's edges; lanes masked out have none.
+    #[test]
+    fn samples_in_lanes_give_the_scalar_bits() {
+        let axis = Vec3::new(-0.5, 1.0, 0.25).normalize();
+        let rotated = Transform::new(glam::Mat4::from_axis_angle(axis, 2.1)).unwrap();
+        let mut s = 0x853c_49e6_748f_ea9bu64;
+        let mut next = || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            (s >> 40) as f32 / (1u64 << 24) as f32
+        };
+        for (w, h, t) in [
+            (2, 3, Transform::IDENTITY),
+            (16, 9, rotated),
+            (40, 33, Transform::IDENTITY),
+        ] {
+            let light = Light::Envmap(Box::new(map(w, h, t)));
+            for round in 0..300 {
+                let edge = |k: usize, v: f32| match k % 11 {
+                    0 => 0.0,
+                    1 => 1.0 - f32::EPSILON / 2.0,
+                    _ => v,
+                };
+                let ux: [f32; 16] = std::array::from_fn(|i| edge(round + i, next()));
+                let uy: [f32; 16] = std::array::from_fn(|i| edge(round + 3 * i + 1, next()));
+                let m = Mask16(0xffff ^ (1 << (round % 16)));
+                let r = V3::splat(0.5);
+                let got = light
+                    .sample_li_lanes(r, F32x16::from_array(ux), F32x16::from_array(uy), m)
+                    .expect("environment maps sample in lanes");
+                assert!(got.at_infinity && !got.delta);
+                let bits = |v: V3<F32x16>, i: usize| {
+                    [v.x.to_array()[i], v.y.to_array()[i], v.z.to_array()[i]].map(f32::to_bits)
+                };
+                for i in 0..16 {
+                    let want = if m.get(i) {
+                        light.sample_li(Vec3::splat(0.5), glam::Vec2::new(ux[i], uy[i]))
+                    } else {
+                        None
+                    };
+                    assert_eq!(got.ok.get(i), want.is_some(), "{w}x{h} lane {i}");
+                    let Some(want) = want else { continue };
+                    let where_ = format!("{w}x{h} u ({}, {}) lane {i}", ux[i], uy[i]);
+                    assert_eq!(
+                        bits(got.wi, i),
+                        [want.wi.x, want.wi.y, want.wi.z].map(f32::to_bits),
+                        "wi {where_}"
+                    );
+                    assert_eq!(
+                        bits(got.p, i),
+                        [want.p.x, want.p.y, want.p.z].map(f32::to_bits),
+                        "p {where_}"
+                    );
+                    assert_eq!(
+                        bits(got.radiance, i),
+                        want.radiance.0.map(f32::to_bits),
+                        "radiance {where_}"
+                    );
+                    assert_eq!(
+                        got.pdf_solid_angle.to_array()[i].to_bits(),
+                        want.pdf_solid_angle.to_bits(),
+                        "pdf {where_}"
+                    );
+                    assert!(want.dist.is_infinite());
+                }
+            }
+        }
     }
 
     /// Each lane of `le_and_pdf_lanes` holds the bits of `Light::le` and `Light::pdf_li`,

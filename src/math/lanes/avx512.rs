@@ -380,6 +380,17 @@ impl F64x8 {
         F64x8(unsafe { _mm512_set1_pd(v) })
     }
 
+    /// `table[idx]` in the lanes of `m` (indices past the end read the last entry), 0
+    /// elsewhere. `table` must not be empty.
+    #[inline(always)]
+    pub fn gather(table: &[f64], idx: U64x8, m: Mask8) -> F64x8 {
+        let last = U64x8::splat(table.len() as u64 - 1);
+        let idx = U64x8(unsafe { _mm512_min_epu64(idx.0, last.0) });
+        F64x8(unsafe {
+            _mm512_mask_i64gather_pd::<8>(_mm512_setzero_pd(), m.0, idx.0, table.as_ptr())
+        })
+    }
+
     #[inline(always)]
     pub fn from_array(a: [f64; 8]) -> F64x8 {
         F64x8(unsafe { _mm512_loadu_pd(a.as_ptr()) })

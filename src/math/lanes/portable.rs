@@ -362,6 +362,20 @@ impl F64x8 {
         F64x8([v; 8])
     }
 
+    /// `table[idx]` in the lanes of `m` (indices past the end read the last entry), 0
+    /// elsewhere. `table` must not be empty.
+    #[inline(always)]
+    pub fn gather(table: &[f64], idx: U64x8, m: Mask8) -> F64x8 {
+        let last = table.len() - 1;
+        F64x8(std::array::from_fn(|i| {
+            if m.get(i) {
+                table[(idx.0[i].min(last as u64)) as usize]
+            } else {
+                0.0
+            }
+        }))
+    }
+
     #[inline(always)]
     pub fn from_array(a: [f64; 8]) -> F64x8 {
         F64x8(a)

@@ -316,6 +316,20 @@ fn gathers_read_their_lanes_and_clamp_indices() {
         };
         assert_eq!((got[i], got_int[i]), (want, want_int), "lane {i}");
     }
+    let wide: Vec<f64> = (0..10).map(|i| i as f64 * 0.25 - 1.0).collect();
+    let (idx_lo, _) = idx.to_u64_halves();
+    let (m_lo, _) = m.halves();
+    let got = F64x8::gather(&wide, idx_lo, m_lo).to_array();
+    let portable = portable::F64x8::gather(&wide, portable::U64x8(idx_lo.to_array()), m_lo);
+    for i in 0..8 {
+        let want = if m.get(i) {
+            wide[((i * 3) % 13).min(9)]
+        } else {
+            0.0
+        };
+        assert_eq!(got[i], want, "f64 lane {i}");
+        assert_eq!(portable.0[i], want, "f64 lane {i} (portable)");
+    }
 }
 
 #[test]
