@@ -96,7 +96,7 @@ pub struct LightSample {
     pub delta: bool,
 }
 
-/// `LightSample`s of area and point lights and environment maps in sixteen lanes (`Light::sample_li_lanes`): the
+/// `LightSample`s of area and point lights and lights at infinity in sixteen lanes (`Light::sample_li_lanes`): the
 /// lanes of `ok` have a sample. Their points lie at a finite distance, and their `front` is
 /// `n`.
 #[derive(Clone, Copy, Debug)]
@@ -449,7 +449,7 @@ impl Light {
 
     /// `sample_li` for the lanes of `m` (reference points `r`, 2D samples `ux`, `uy`),
     /// lane by lane the same bits; None for lights the lanes cannot sample (all but point
-    /// lights, environment maps and area lights on meshes without vertex normals).
+    /// lights, lights at infinity and area lights on meshes without vertex normals).
     #[inline]
     pub fn sample_li_lanes(
         &self,
@@ -462,6 +462,7 @@ impl Light {
             Light::Area(l) => l.sample_li_lanes(r, ux, uy, m)?,
             Light::Point(l) => l.sample_li_lanes(r, m),
             Light::Envmap(l) => l.sample_li_lanes(ux, uy, m)?,
+            Light::Constant(l) => l.sample_li_lanes(ux, uy, m),
             _ => return None,
         };
         // The checks of `sample_li`.

@@ -24,10 +24,18 @@ pub fn triangle_barycentrics<T: Real>(ux: T, uy: T) -> (T, T) {
 
 /// Uniform direction on the unit sphere; pdf 1/(4π).
 pub fn square_to_sphere(u: Vec2) -> Vec3 {
-    let z = 1.0 - 2.0 * u.x;
-    let r = (1.0 - z * z).max(0.0).sqrt();
-    let phi = 2.0 * std::f32::consts::PI * u.y;
-    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+    sphere_direction(u.x, u.y).into()
+}
+
+/// `square_to_sphere` over `Real` (one direction, or sixteen in lanes), with
+/// `sin_cos_turns` for the azimuth.
+#[inline(always)]
+pub fn sphere_direction<T: Real>(ux: T, uy: T) -> V3<T> {
+    let one = T::splat(1.0);
+    let z = one - T::splat(2.0) * ux;
+    let r = (one - z * z).max_gt(T::splat(0.0)).sqrt();
+    let (sin, cos) = sin_cos_turns(T::splat(2.0 * PI) * uy);
+    V3::new(r * cos, r * sin, z)
 }
 
 /// Solid-angle density of `square_to_sphere`: 1/(4π).
