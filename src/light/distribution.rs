@@ -131,6 +131,7 @@ impl Distribution1D {
 
     /// Draws an item: (index, its probability, `u` rescaled to [0, 1) within the item's cdf
     /// interval, fresh for reuse).
+    #[inline(always)]
     pub fn sample_discrete(&self, u: f32) -> (usize, f32, f32) {
         let (i, remapped) = self.row().sample_discrete(u);
         // The probability as `pmf` computes it, so MIS weights see identical values.
