@@ -2,11 +2,15 @@
 //! primary sample space (Hachisuka et al. 2014, "Multiplexed Metropolis light transport").
 //!
 //! The first number of the connection stream picks the path length d (segments, Mitsuba's
-//! count) with probability p(d) and, within it, one of the d + 1 strategies (s, t),
-//! s + t = d + 1, t ≥ 1, uniformly. Only that strategy is traced: a camera subpath of t
+//! count) with probability p(d), the second one of its d + 1 strategies (s, t),
+//! s + t = d + 1, t ≥ 1, uniformly. Two numbers, not one: a small step moves each by about
+//! 1/256 (Kelemen's), while one number's interval per strategy would be only p(d)/(d + 1)
+//! wide (about 0.01 for the longer paths of door-ajar), so most small steps would have
+//! switched strategy, which leaves nothing of the path in place, and been rejected. Only
+//! that strategy is traced: a camera subpath of t
 //! vertices and a light subpath of s. Its contribution is the strategy's MIS-weighted
 //! value over the probability of picking it, C·w_(s,t)·(d + 1)/p(d), so the expected value
-//! over the first number is the sum over all strategies and lengths: the image.
+//! over the first two numbers is the sum over all strategies and lengths: the image.
 //!
 //! p(d) comes from the bootstrap, which runs per path length: p(d) ∝ b_d, the mean
 //! importance of length d, mixed with a uniform share (`UNIFORM_SHARE`) so that a length the
@@ -65,6 +69,27 @@ impl MultiplexedTarget {
         self.cdf[d] - self.cdf[d - 1]
     }
 
+    /// The path length d, the strategy's s and the probability of picking length d, from
+    /// the connection stream's first number `u_length` (ignored for a bootstrap `stratum`,
+    /// which is the length) and its second `u_strategy`. The strategy depends on
+    /// `u_strategy` alone: s = ⌊u_strategy·(d + 1)⌋.
+    fn choose(
+        &self,
+        u_length: f64,
+        u_strategy: f64,
+        stratum: Option<usize>,
+    ) -> (usize, usize, f64) {
+        let (d, pick) = match stratum {
+            Some(k) => (k + 1, 1.0),
+            None => {
+                let d = self.length_of(u_length);
+                (d, self.length_probability(d))
+            }
+        };
+        let s = ((u_strategy * (d + 1) as f64) as usize).min(d);
+        (d, s, pick)
+    }
+
     /// The path length whose interval of the cdf holds u.
     fn length_of(&self, u: f64) -> usize {
         // The first k with cdf[k] > u, skipping lengths of probability 0.
@@ -93,19 +118,12 @@ impl PathTarget for MultiplexedTarget {
         if self.max_depth == 0 {
             return eval;
         }
-        // The path length and strategy from the connection stream's first number.
+        // The path length and the strategy from the connection stream's first two numbers.
         sampler.start_stream(Stream::Connect);
-        let u = sampler.next_1d() as f64;
-        let (d, local, pick) = match stratum {
-            Some(k) => (k + 1, u, 1.0),
-            None => {
-                let d = self.length_of(u);
-                let p = self.length_probability(d);
-                ((d), ((u - self.cdf[d - 1]) / p).clamp(0.0, 1.0), p)
-            }
-        };
+        let u_length = sampler.next_1d() as f64;
+        let u_strategy = sampler.next_1d() as f64;
+        let (d, s, pick) = self.choose(u_length, u_strategy, stratum);
         let strategies = d + 1;
-        let s = ((local * strategies as f64) as usize).min(d);
         let t = d + 1 - s;
         if s == 0 && t == 1 {
             return eval;
@@ -203,5 +221,50 @@ impl PathTarget for MultiplexedTarget {
         let d = stratum + 1;
         let (lo, p) = (self.cdf[d - 1], self.length_probability(d));
         sampler.map_value(Stream::Connect, 0, |local| lo + local * p);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The strategy is a function of its own number, in intervals 1/(d + 1) wide whatever
+    /// p(d) is: moving the length's number inside its interval never switches strategy,
+    /// and every strategy of every length is reached with the probability the weight
+    /// divides by. (With one number for both, the strategies' intervals were p(d)/(d + 1)
+    /// wide and a small step switched strategy when it moved the length's number.)
+    #[test]
+    fn the_strategy_has_its_own_number() {
+        let path = PathSettings {
+            max_depth: Some(10),
+            rr_depth: 5,
+            hide_emitters: false,
+        };
+        let mut target = MultiplexedTarget::new(path, Heuristic::Power, 10);
+        // Lengths of very unequal weight, as a bootstrap finds them.
+        target.set_stratum_means(&[0.0, 5.0, 3.0, 1.0, 0.5, 0.2, 0.1, 0.05, 0.01, 0.0]);
+        for d in 1..=10 {
+            let (lo, p) = (target.cdf[d - 1], target.length_probability(d));
+            assert!(p > 0.0, "length {d} unreachable");
+            let mut counts = vec![0usize; d + 1];
+            let n = 2000 * (d + 1);
+            for k in 0..n {
+                let u_strategy = (k as f64 + 0.5) / n as f64;
+                let want = (u_strategy * (d + 1) as f64) as usize;
+                for f in [0.001, 0.3, 0.5, 0.999] {
+                    let (got_d, s, pick) = target.choose(lo + f * p, u_strategy, None);
+                    assert_eq!((got_d, s), (d, want), "length {d}, u {u_strategy}, at {f}");
+                    assert_eq!(pick, p);
+                }
+                counts[want] += 1;
+            }
+            // Each strategy equally often: 1/(d + 1), the factor the value carries.
+            assert!(counts.iter().all(|&c| c == 2000), "length {d}: {counts:?}");
+            // A bootstrap stratum fixes the length and ignores the length's number.
+            assert_eq!(
+                target.choose(0.0, 0.7, Some(d - 1)),
+                (d, ((0.7 * (d + 1) as f64) as usize).min(d), 1.0)
+            );
+        }
     }
 }
