@@ -181,6 +181,53 @@ fn normalisation_is_the_image_mean_luminance() {
     }
 }
 
+/// `normalisation=large_steps` pools the bootstrap with every large step's proposal: from
+/// a bootstrap of only 1000 points, the pooled b lands on the long `bdpt` image's mean
+/// luminance within 4 σ of the two (the pooled b's σ from the bootstrap's spread over all
+/// the points pooled), and the image's mean luminance is that b (each step splats b in
+/// luminance).
+#[test]
+fn pooled_normalisation_converges_to_the_image_mean() {
+    let scene = shipped_scene("cbox-spheres.xml", 32);
+    let bdpt = runs("bdpt", &scene, &[], 8, 64, 3000);
+    let luminance = |im: &Image| {
+        im.pixels.iter().map(|p| p.luminance() as f64).sum::<f64>() / im.pixels.len() as f64
+    };
+    let (mean, se) = mean_and_standard_error(&bdpt.iter().map(luminance).collect::<Vec<_>>());
+    for (name, param) in METROPOLIS {
+        let params = Params::parse(&[
+            param,
+            "bootstrap=1000",
+            "chains=16",
+            "normalisation=large_steps",
+        ])
+        .unwrap();
+        let mut e = estimator::create(name, &params, &scene, 8).unwrap();
+        render(&scene, e.as_mut(), Budget::Passes(64), |_, _| {});
+        let d = e.diagnostics().expect("diagnostics");
+        let b = d["b_pooled"]
+            .as_f64()
+            .expect("b_pooled with normalisation=large_steps");
+        let n_boot = d["bootstrap"]["samples"].as_f64().unwrap();
+        let spread = d["bootstrap"]["b_standard_error"].as_f64().unwrap() * n_boot.sqrt();
+        let n_large = d["large_steps"]["proposed"].as_f64().unwrap();
+        let b_se = spread / (n_boot + n_large).sqrt();
+        let sigma = (se * se + b_se * b_se).sqrt();
+        eprintln!(
+            "{name} {param}: pooled b {b:.5} ± {b_se:.1e} over {n_large} large steps, bdpt {mean:.5} ± {se:.1e}"
+        );
+        assert!(
+            (b - mean).abs() < SIGMAS * sigma,
+            "{name} {param}: pooled b = {b} ± {b_se} against the image's {mean} ± {se}"
+        );
+        let image_mean = luminance(&e.image());
+        assert!(
+            (image_mean / b - 1.0).abs() < 1e-3,
+            "{name} {param}: image mean {image_mean} against b {b}"
+        );
+    }
+}
+
 /// With large_step=1 every proposal is an independent sample: the chain is then an
 /// independence sampler and agrees with its base estimator.
 #[test]
@@ -201,11 +248,12 @@ fn large_steps_only_agree_with_the_base_estimator() {
 #[test]
 fn thread_count_does_not_matter() {
     let scene = shipped_scene("cbox-spheres.xml", 40);
-    let relative = [
+    let variants = [
         ("pssmlt", "importance=relative"),
         ("mmlt", "importance=relative"),
+        ("mmlt", "normalisation=large_steps"),
     ];
-    for (name, param) in METROPOLIS.into_iter().chain(relative) {
+    for (name, param) in METROPOLIS.into_iter().chain(variants) {
         let bits = |threads: usize, seed: u64| -> Vec<u32> {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -244,6 +292,7 @@ fn bad_parameters_are_refused_naming_them() {
             ("s1=0.1", "s2"),
             ("bootstrap=0", "bootstrap"),
             ("importance=radiance", "importance"),
+            ("normalisation=mean", "normalisation"),
             ("wavefront=false", "wavefront"),
             ("strategies=true", "strategies"),
         ] {
@@ -254,6 +303,13 @@ fn bad_parameters_are_refused_naming_them() {
             assert!(err.contains(expected), "{name} {param}: {err}");
         }
     }
+    // Kelemen's weights use b while splatting: b cannot be pooled afterwards.
+    let both = Params::parse(&["kelemen_weights=true", "normalisation=large_steps"]).unwrap();
+    let err = estimator::create("pssmlt", &both, &scene, 1)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(err.contains("normalisation"), "{err}");
     let err = estimator::create("pssmlt", &Params::parse(&["base=lt"]).unwrap(), &scene, 1)
         .err()
         .unwrap()

@@ -28,6 +28,8 @@ pub struct ChainCounts {
     pub small_accepted: u64,
     pub large_proposed: u64,
     pub large_accepted: u64,
+    /// Σ of the large steps' proposals' importance (independent points: `Normalisation`).
+    pub large_importance: f64,
     pub rays: u64,
     pub invalid: u64,
 }
@@ -38,6 +40,7 @@ impl ChainCounts {
         self.small_accepted += other.small_accepted;
         self.large_proposed += other.large_proposed;
         self.large_accepted += other.large_accepted;
+        self.large_importance += other.large_importance;
         self.rays += other.rays;
         self.invalid += other.invalid;
     }
@@ -114,6 +117,7 @@ impl Chain {
         if large {
             self.counts.large_proposed += 1;
             self.counts.large_accepted += accept as u64;
+            self.counts.large_importance += i_new;
         } else {
             self.counts.small_proposed += 1;
             self.counts.small_accepted += accept as u64;

@@ -85,6 +85,9 @@ pub struct Diagnostics {
     pub importance: String,
     /// `importance=relative`: the pilot's block side in pixels (set by the estimator).
     pub pilot_block: Option<u32>,
+    /// `normalisation=large_steps`: the b the image is scaled by, pooled from the bootstrap
+    /// and every large step (set by the estimator); None with the bootstrap's b.
+    pub b_pooled: Option<f64>,
     pub bootstrap: Bootstrap,
     pub chains: u64,
     /// Chains that accepted no proposal.
@@ -143,6 +146,7 @@ impl Diagnostics {
             kelemen_weights: settings.kelemen_weights,
             importance: settings.importance.name().to_string(),
             pilot_block: None,
+            b_pooled: None,
             bootstrap: bootstrap.clone(),
             chains: chains.len() as u64,
             chains_never_moved: chains

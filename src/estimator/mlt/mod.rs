@@ -15,7 +15,9 @@
 //!   (pass, chain) order, so images are bit-identical for any `--threads` and for passes
 //!   taken one at a time or in chunks. One thread merges a pass's lists while the chains
 //!   take the next pass; the last pass's lists wait for the next call or for `image()`.
-//! * Image = b × (expected-value splats) / mutations per pixel (`chain`).
+//! * Image = b × (expected-value splats) / mutations per pixel (`chain`). b is the
+//!   bootstrap's, or with `normalisation=large_steps` the bootstrap pooled with every large
+//!   step's proposal so far (`settings::Normalisation`), applied when the image is read.
 //! * `importance`: the target is the luminance of a state's contributions, or with
 //!   `importance=relative` their luminance relative to a pilot estimate of each pixel, made
 //!   from independent points of its own before the bootstrap.
@@ -50,7 +52,7 @@ use diagnostics::{Bootstrap, Diagnostics};
 use glam::Vec2;
 use importance::{ImportanceKind, PilotMap};
 use multiplexed::MultiplexedTarget;
-use settings::ChainSettings;
+use settings::{ChainSettings, Normalisation};
 use target::{BdptTarget, Contributions, PathTarget, PtTarget};
 
 /// Keys that keep the bootstrap's, the chains' and the selection's streams apart.
@@ -354,6 +356,33 @@ impl<T: PathTarget> Metropolis<T> {
     }
 
     /// The diagnostics so far (None before the first pass).
+    /// `normalisation=large_steps`: b from the bootstrap's points and every large step's
+    /// proposal so far, pooled by their counts (chain by chain, in chain order).
+    pub fn pooled_b(&self) -> Option<f64> {
+        let bootstrap = self.bootstrap.as_ref()?;
+        let mut sum = bootstrap.b * bootstrap.samples as f64;
+        let mut count = bootstrap.samples as f64;
+        for chain in &self.chains {
+            sum += chain.counts.large_importance;
+            count += chain.counts.large_proposed as f64;
+        }
+        Some(if count > 0.0 { sum / count } else { 0.0 })
+    }
+
+    /// The image of `film`'s splats: per mutation, times b where the splats carry b = 1.
+    fn read_film(&self, film: &Film) -> Image {
+        let samples = self.stats.samples;
+        match self.settings.normalisation {
+            Normalisation::Bootstrap => film.image_with_light_paths(samples),
+            Normalisation::LargeSteps if samples > 0 => {
+                let pixels = film.width() as f64 * film.height() as f64;
+                let b = self.pooled_b().unwrap_or(0.0);
+                film.image(pixels / samples as f64 * b)
+            }
+            Normalisation::LargeSteps => film.image(0.0),
+        }
+    }
+
     pub fn diagnostics_report(&self) -> Option<Diagnostics> {
         let bootstrap = self.bootstrap.as_ref()?;
         let mut report = Diagnostics::new(
@@ -366,6 +395,9 @@ impl<T: PathTarget> Metropolis<T> {
             self.bootstrap_seconds,
         );
         report.pilot_block = self.pilot.as_ref().map(PilotMap::block_size);
+        if self.settings.normalisation == Normalisation::LargeSteps {
+            report.b_pooled = self.pooled_b();
+        }
         Some(report)
     }
 }
@@ -393,7 +425,12 @@ impl<T: PathTarget> Estimator for Metropolis<T> {
         let pixels = self.film.width() as u64 * self.film.height() as u64;
         let n_chains = self.chains.len() as u64;
         let settings = self.settings;
-        let b = self.bootstrap.as_ref().map_or(0.0, |s| s.b);
+        // With b pooled from the large steps, the splats are scaled by it when the image is
+        // read (`image`), so they carry b = 1 here.
+        let b = match settings.normalisation {
+            Normalisation::Bootstrap => self.bootstrap.as_ref().map_or(0.0, |s| s.b),
+            Normalisation::LargeSteps => 1.0,
+        };
         let Metropolis {
             target,
             chains,
@@ -442,13 +479,13 @@ impl<T: PathTarget> Estimator for Metropolis<T> {
 
     fn image(&self) -> Image {
         if self.pending.iter().all(SplatList::is_empty) {
-            return self.film.image_with_light_paths(self.stats.samples);
+            return self.read_film(&self.film);
         }
         let mut film = self.film.clone();
         for list in &self.pending {
             film.merge_splats(list);
         }
-        film.image_with_light_paths(self.stats.samples)
+        self.read_film(&film)
     }
 
     fn stats(&self) -> Stats {

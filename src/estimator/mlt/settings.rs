@@ -21,11 +21,26 @@ pub struct ChainSettings {
     pub kelemen_weights: bool,
     /// What the target density is proportional to (`importance.rs`).
     pub importance: ImportanceKind,
+    /// Where the normalisation b comes from.
+    pub normalisation: Normalisation,
+}
+
+/// Where the normalisation b (the mean importance) comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Normalisation {
+    /// The bootstrap's estimate, fixed for the whole run (Kelemen et al. 2002): its error
+    /// does not shrink with time, and where the importance is heavy-tailed most bootstraps
+    /// miss the rare bright points and leave the whole image too dark.
+    Bootstrap,
+    /// The bootstrap's points and every large step's proposal so far, pooled by their
+    /// counts: large steps are independent uniform points too, so b keeps converging while
+    /// the chains run (consistent; the splats are scaled by it when the image is read).
+    LargeSteps,
 }
 
 impl ChainSettings {
     /// Reads `large_step`, `mutation`, `s1`, `s2`, `sigma`, `bootstrap`, `chains`,
-    /// `importance` and, when `with_kelemen_weights`, `kelemen_weights`; each bad value is
+    /// `importance`, `normalisation` and, when `with_kelemen_weights`, `kelemen_weights`; each bad value is
     /// an error naming it.
     pub fn from_params(params: &Params, with_kelemen_weights: bool) -> Result<ChainSettings> {
         let large_step: f64 = params.get("large_step", 0.3)?;
@@ -88,6 +103,24 @@ impl ChainSettings {
                 )));
             }
         };
+        let normalisation = match params
+            .get("normalisation", "bootstrap".to_string())?
+            .as_str()
+        {
+            "bootstrap" => Normalisation::Bootstrap,
+            "large_steps" if kelemen_weights => {
+                return Err(Error::usage(
+                    "--set normalisation=large_steps: not with kelemen_weights=true (whose \
+                     weights use b while splatting)",
+                ));
+            }
+            "large_steps" => Normalisation::LargeSteps,
+            other => {
+                return Err(Error::usage(format!(
+                    "--set normalisation={other}: expected bootstrap or large_steps"
+                )));
+            }
+        };
         Ok(ChainSettings {
             large_step,
             mutation,
@@ -95,6 +128,7 @@ impl ChainSettings {
             chains,
             kelemen_weights,
             importance,
+            normalisation,
         })
     }
 }
