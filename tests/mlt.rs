@@ -156,15 +156,22 @@ fn relative_importance_agrees_with_bdpt() {
     }
 }
 
+/// An image's mean luminance.
+fn mean_luminance(im: &Image) -> f64 {
+    im.pixels.iter().map(|p| p.luminance() as f64).sum::<f64>() / im.pixels.len() as f64
+}
+
+/// The mean luminance of 8 `bdpt` runs of 64 passes, and its standard error.
+fn bdpt_mean_luminance(scene: &Scene) -> (f64, f64) {
+    let bdpt = runs("bdpt", scene, &[], 8, 64, 3000);
+    mean_and_standard_error(&bdpt.iter().map(mean_luminance).collect::<Vec<_>>())
+}
+
 /// The bootstrap's normalisation b is the mean luminance of the image.
 #[test]
 fn normalisation_is_the_image_mean_luminance() {
     let scene = shipped_scene("cbox-spheres.xml", 32);
-    let bdpt = runs("bdpt", &scene, &[], 8, 64, 3000);
-    let luminance = |im: &Image| {
-        im.pixels.iter().map(|p| p.luminance() as f64).sum::<f64>() / im.pixels.len() as f64
-    };
-    let (mean, se) = mean_and_standard_error(&bdpt.iter().map(luminance).collect::<Vec<_>>());
+    let (mean, se) = bdpt_mean_luminance(&scene);
     for (name, param) in METROPOLIS {
         let params = Params::parse(&[param, "bootstrap=100000"]).unwrap();
         let mut e = estimator::create(name, &params, &scene, 7).unwrap();
@@ -189,11 +196,7 @@ fn normalisation_is_the_image_mean_luminance() {
 #[test]
 fn pooled_normalisation_converges_to_the_image_mean() {
     let scene = shipped_scene("cbox-spheres.xml", 32);
-    let bdpt = runs("bdpt", &scene, &[], 8, 64, 3000);
-    let luminance = |im: &Image| {
-        im.pixels.iter().map(|p| p.luminance() as f64).sum::<f64>() / im.pixels.len() as f64
-    };
-    let (mean, se) = mean_and_standard_error(&bdpt.iter().map(luminance).collect::<Vec<_>>());
+    let (mean, se) = bdpt_mean_luminance(&scene);
     for (name, param) in METROPOLIS {
         let params = Params::parse(&[
             param,
@@ -220,7 +223,7 @@ fn pooled_normalisation_converges_to_the_image_mean() {
             (b - mean).abs() < SIGMAS * sigma,
             "{name} {param}: pooled b = {b} ± {b_se} against the image's {mean} ± {se}"
         );
-        let image_mean = luminance(&e.image());
+        let image_mean = mean_luminance(&e.image());
         assert!(
             (image_mean / b - 1.0).abs() < 1e-3,
             "{name} {param}: image mean {image_mean} against b {b}"
