@@ -10,6 +10,8 @@
 use super::independent::HASH_START;
 use crate::math::lanes::{F32x16, Mask16, U32x16, U64x8};
 
+const _: () = assert!(std::mem::size_of::<[[U64x8; 2]; 4]>() == 64 * 8);
+
 /// The states of sixteen Xoshiro256++ generators: word k of lanes 0–7 in `s[k][0]`, of
 /// lanes 8–15 in `s[k][1]`.
 #[derive(Clone, Copy)]
@@ -26,13 +28,28 @@ impl Default for LaneStreams {
 }
 
 impl LaneStreams {
+    /// The states as plain words: word k of lane i at 16k + i (lanes 0–7 are `s[k][0]`,
+    /// 8–15 `s[k][1]`). A lane leaving for scalar code (and coming back) touches four words
+    /// in memory this way, instead of four whole vectors taken apart and rebuilt.
+    #[inline(always)]
+    fn words(&self) -> &[u64; 64] {
+        // SAFETY: `s` is 4·2 `U64x8`s of eight u64 each, without padding (checked below in
+        // both backends), so it has the size of [u64; 64] and at least its alignment.
+        unsafe { &*(&self.s as *const [[U64x8; 2]; 4] as *const [u64; 64]) }
+    }
+
+    #[inline(always)]
+    fn words_mut(&mut self) -> &mut [u64; 64] {
+        // SAFETY: as `words`; every bit pattern is a valid u64 and a valid `U64x8`.
+        unsafe { &mut *(&mut self.s as *mut [[U64x8; 2]; 4] as *mut [u64; 64]) }
+    }
+
     /// Lane `lane` continues the stream with state `state` (`IndependentSampler::state`).
+    #[inline]
     pub fn set_lane(&mut self, lane: usize, state: [u64; 4]) {
-        let (half, i) = (lane / 8, lane % 8);
+        let words = self.words_mut();
         for (k, &word) in state.iter().enumerate() {
-            let mut words = self.s[k][half].to_array();
-            words[i] = word;
-            self.s[k][half] = U64x8::from_array(words);
+            words[16 * k + lane] = word;
         }
     }
 
@@ -65,9 +82,10 @@ impl LaneStreams {
     }
 
     /// The state of lane `lane`'s stream.
+    #[inline]
     pub fn lane(&self, lane: usize) -> [u64; 4] {
-        let (half, i) = (lane / 8, lane % 8);
-        std::array::from_fn(|k| self.s[k][half].to_array()[i])
+        let words = self.words();
+        std::array::from_fn(|k| words[16 * k + lane])
     }
 
     #[cfg(test)]
