@@ -879,7 +879,7 @@ fn packet_queries_match_single_ray_queries() {
         cube_sphere(Vec3::new(0.6, 0.3, 0.4), 0.15, 1),
     ));
     // A small scene with analytic shapes: spheres (two overlapping, one with its normals
-    // flipped, one that some rays start inside) and a disk, tested in f64 lanes.
+    // flipped, one that some rays start inside) and disks, tested in f64 lanes.
     let mut small_analytic = cornell_box(1.0);
     small_analytic.push(sphere_shape(Vec3::new(0.3, 0.3, 0.3), 0.2, false));
     small_analytic.push(sphere_shape(Vec3::new(0.42, 0.35, 0.3), 0.15, false));
@@ -888,6 +888,12 @@ fn packet_queries_match_single_ray_queries() {
         * Mat4::from_rotation_x(0.6)
         * Mat4::from_scale(Vec3::splat(0.2));
     small_analytic.push(disk_shape(disk, false));
+    // A second, larger disk crossing the first and a sphere: the nearest of several
+    // analytic hits must win in each lane.
+    let disk = Mat4::from_translation(Vec3::new(0.45, 0.5, 0.5))
+        * Mat4::from_rotation_y(0.9)
+        * Mat4::from_scale(Vec3::splat(0.35));
+    small_analytic.push(disk_shape(disk, true));
     for (name, shapes) in [
         ("small", small),
         ("small and analytic", small_analytic),

@@ -7,6 +7,7 @@ use glam::{DMat4, DVec3, Mat4, Vec2, Vec3};
 use super::AnalyticHit;
 use super::offset::gamma;
 use crate::math::Transform;
+use crate::math::lanes::{F64x8, Mask8};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Disk {
@@ -62,6 +63,40 @@ impl Disk {
             return None;
         }
         Some((t, [x, y]))
+    }
+
+    /// `intersect` for eight rays in f64 lanes (origins `o`, directions `d` widened from
+    /// f32, segment ends `t_max`), lane by lane the same operations in the same order as
+    /// glam's `transform_point3` and `transform_vector3` and the test above, so the same
+    /// bits: the lanes of `m` that hit, their t and local (x, y).
+    #[inline(always)]
+    pub fn intersect_lanes(
+        &self,
+        o: &[F64x8; 3],
+        d: &[F64x8; 3],
+        t_max: F64x8,
+        m: Mask8,
+    ) -> (Mask8, F64x8, [F64x8; 2]) {
+        let splat = F64x8::splat;
+        let a = &self.to_local64;
+        // Row k of the local point: x_axis·o.x, then y_axis·o.y + that, then z_axis·o.z +
+        // that (then w_axis + that for a point), as glam sums the columns.
+        let row = |k: usize, v: &[F64x8; 3]| {
+            let r = splat(a.x_axis[k]) * v[0];
+            let r = splat(a.y_axis[k]) * v[1] + r;
+            splat(a.z_axis[k]) * v[2] + r
+        };
+        let ol = [0, 1, 2].map(|k| splat(a.w_axis[k]) + row(k, o));
+        let dl = [0, 1, 2].map(|k| row(k, d));
+        let t = -ol[2] / dl[2];
+        let between = m & t.gt(splat(0.0)) & t.lt(t_max);
+        if between.none() {
+            return (Mask8::NONE, t, [t, t]);
+        }
+        let x = ol[0] + t * dl[0];
+        let y = ol[1] + t * dl[1];
+        let outside = (x * x + y * y).gt(splat(1.0));
+        (between & !outside, t, [x, y])
     }
 
     /// The surface data at local point (x, y). The point is M·(x, y, 0, 1) in f64: exactly

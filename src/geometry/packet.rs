@@ -10,9 +10,9 @@
 //! rounding error bound is settled from its own values; any other candidate goes through
 //! `triangle::intersect` itself. `tests/geometry.rs` compares both queries ray by ray.
 //!
-//! The analytic shapes of a small scene come first, as in the per-ray queries: spheres in
-//! f64 lanes (`Sphere::intersect_lanes`, the same operations in the same order), disks one
-//! lane at a time; the triangles are then tested within what is left of each segment.
+//! The analytic shapes of a small scene come first, as in the per-ray queries: spheres and
+//! disks in f64 lanes (`Sphere::intersect_lanes`, `Disk::intersect_lanes`: the same
+//! operations in the same order); the triangles are then tested within what is left of each segment.
 //! Scenes with a tree are answered one lane at a time by the per-ray queries.
 
 use super::triangle::{self, BoundArithmetic, TriangleHit, TriangleRay, TriangleRecord};
@@ -570,10 +570,10 @@ impl Geometry {
         out.hit = out.best.hit | analytic;
     }
 
-    /// `closest_analytic` for the lanes of `m`: spheres in f64 lanes, disks one lane at a
-    /// time. Writes each lane's hit to `hits` and returns the lanes that hit and the
-    /// segment left for the triangles (t_max in the scaled rays' units, shortened to the
-    /// hit where there is one).
+    /// `closest_analytic` for the lanes of `m`: spheres, then disks, in f64 lanes. Writes
+    /// each lane's hit to `hits` and returns the lanes that hit and the segment left for
+    /// the triangles (t_max in the scaled rays' units, shortened to the hit where there is
+    /// one).
     #[inline(always)]
     fn closest_analytic_lanes(
         &self,
@@ -604,22 +604,26 @@ impl Geometry {
                 }
             }
         }
-        let mut found = Mask16::from_halves(found[0], found[1]);
-        if !self.disks.is_empty() {
-            let rays = r.lanes();
-            let mut t = [t_max[0].to_array(), t_max[1].to_array()];
-            for i in m.lanes() {
-                let t_max64 = &mut t[i / 8][i % 8];
-                for (index, disk) in self.disks.iter().enumerate() {
-                    if let Some((t, local)) = disk.intersect(rays[i].o, rays[i].d, *t_max64) {
-                        *t_max64 = t;
-                        hits[i] = Some(Hit::Disk { index, t, local });
-                        found.set(i, true);
-                    }
+        for (h, m) in [m_lo, m_hi].into_iter().enumerate() {
+            let (o, d) = wide.half(h);
+            for (index, disk) in self.disks.iter().enumerate() {
+                let (hit, t, [x, y]) = disk.intersect_lanes(&o, &d, t_max[h], m);
+                if hit.none() {
+                    continue;
+                }
+                t_max[h] = F64x8::select(hit, t, t_max[h]);
+                found[h] |= hit;
+                let [t, x, y] = [t, x, y].map(F64x8::to_array);
+                for i in hit.lanes() {
+                    hits[8 * h + i] = Some(Hit::Disk {
+                        index,
+                        t: t[i],
+                        local: [x[i], y[i]],
+                    });
                 }
             }
-            t_max = t.map(F64x8::from_array);
         }
+        let found = Mask16::from_halves(found[0], found[1]);
         let shortened = F32x16::from_f64_halves(t_max[0], t_max[1]);
         (found, F32x16::select(found, shortened, r.t_max))
     }
@@ -643,22 +647,15 @@ impl Geometry {
                 }
                 found[h] |= s.intersect_lanes(&o, &d, t_max[h], open).0;
             }
-        }
-        let mut found = Mask16::from_halves(found[0], found[1]);
-        if !self.disks.is_empty() {
-            let rays = r.lanes();
-            for i in (m & !found).lanes() {
-                let t_max64 = rays[i].t_max as f64;
-                if self
-                    .disks
-                    .iter()
-                    .any(|d| d.intersect(rays[i].o, rays[i].d, t_max64).is_some())
-                {
-                    found.set(i, true);
+            for disk in &self.disks {
+                let open = m & !found[h];
+                if open.none() {
+                    break;
                 }
+                found[h] |= disk.intersect_lanes(&o, &d, t_max[h], open).0;
             }
         }
-        found
+        Mask16::from_halves(found[0], found[1])
     }
 
     /// The surface data of `hits`: in lanes for the sixteen-ray test's hits, through
