@@ -48,6 +48,7 @@ pub struct Connection<'a> {
 /// The unweighted contribution of strategy (s, t); None when it gives nothing. Draws a
 /// light choice and a light point for s = 1, a lens point for t = 1 with a thin lens.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub fn connect<'a>(
     scene: &'a Scene,
     light_path: &[Vertex<'a>],
