@@ -37,6 +37,7 @@ impl Sphere {
     /// the centre to o), so a·disc = r²·a − |f × d|² needs no division, and a ray that
     /// misses (most tests) costs no division or square root. The roots use the stable
     /// quadratic formula (no subtraction of nearly equal numbers).
+    #[inline(always)]
     pub fn intersect(&self, o: Vec3, d: Vec3, t_max: f64) -> Option<f64> {
         let d = d.as_dvec3();
         let f = o.as_dvec3() - self.center.as_dvec3();
