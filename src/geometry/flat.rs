@@ -276,9 +276,153 @@ fn lane_tests(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
     }
 }
 
-/// `lane_tests` in portable code (autovectorised), for targets without AVX-512.
+/// Eight lanes of f32 in one AVX2 register, for `triangle::t_num_error_bound_in`.
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    not(target_feature = "avx512f")
+))]
+mod lanes_avx2 {
+    use std::arch::x86_64::*;
+
+    #[derive(Clone, Copy)]
+    pub(super) struct Lanes(pub __m256);
+
+    // SAFETY (every intrinsic below): AVX2 (and so AVX) is enabled at compile time (the
+    // module's cfg); register operations only.
+    impl std::ops::Add for Lanes {
+        type Output = Lanes;
+        #[inline(always)]
+        fn add(self, o: Lanes) -> Lanes {
+            Lanes(unsafe { _mm256_add_ps(self.0, o.0) })
+        }
+    }
+
+    impl std::ops::Mul for Lanes {
+        type Output = Lanes;
+        #[inline(always)]
+        fn mul(self, o: Lanes) -> Lanes {
+            Lanes(unsafe { _mm256_mul_ps(self.0, o.0) })
+        }
+    }
+
+    impl super::triangle::BoundArithmetic for Lanes {
+        #[inline(always)]
+        fn splat(v: f32) -> Lanes {
+            Lanes(unsafe { _mm256_set1_ps(v) })
+        }
+    }
+}
+
+/// The watertight test's arithmetic on the sixteen lanes of `c` (see `LaneTests`), as two
+/// AVX2 halves of eight: the operations of the AVX-512 version, lane for lane.
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    not(target_feature = "avx512f")
+))]
+#[inline(always)]
+fn lane_tests(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
+    use lanes_avx2::Lanes;
+    use std::arch::x86_64::*;
+    let mut out = LaneTests {
+        e: [[0.0; LANES]; 3],
+        t_num: [0.0; LANES],
+        keep: 0,
+        settled: 0,
+    };
+    // SAFETY: AVX2 is enabled at compile time (cfg above); `Chunk` and `LaneTests` are
+    // 64-byte aligned and each row is 16 floats, so the aligned loads and stores of lanes
+    // `base..base + 8` (base 0 or 8: 32-byte aligned) stay inside them.
+    unsafe {
+        let splat = _mm256_set1_ps;
+        let (cx, cy, cz) = (&c.v[r.kx], &c.v[r.ky], &c.v[r.kz]);
+        let (ox, oy, oz) = (splat(r.ox), splat(r.oy), splat(r.oz));
+        let (sx, sy, sz) = (splat(r.sx), splat(r.sy), splat(r.sz));
+        let zero = _mm256_setzero_ps();
+        let lt = |a, b| _mm256_cmp_ps::<_CMP_LT_OQ>(a, b);
+        let is_zero = |e| _mm256_cmp_ps::<_CMP_EQ_OQ>(e, zero);
+        let or = |a, b| _mm256_or_ps(a, b);
+        let and = |a, b| _mm256_and_ps(a, b);
+        for base in [0, LANES / 2] {
+            let load = |row: &[f32; LANES]| _mm256_load_ps(row.as_ptr().add(base));
+            // Sheared vertex coordinates, as `triangle::intersect_scalar`.
+            let vertex = |j: usize| {
+                let z = _mm256_sub_ps(load(&cz[j]), oz);
+                let x = _mm256_sub_ps(_mm256_sub_ps(load(&cx[j]), ox), _mm256_mul_ps(sx, z));
+                let y = _mm256_sub_ps(_mm256_sub_ps(load(&cy[j]), oy), _mm256_mul_ps(sy, z));
+                (x, y, z)
+            };
+            let (x0, y0, z0) = vertex(0);
+            let (x1, y1, z1) = vertex(1);
+            let (x2, y2, z2) = vertex(2);
+            let edge =
+                |xa, yb, ya, xb| _mm256_sub_ps(_mm256_mul_ps(xa, yb), _mm256_mul_ps(ya, xb));
+            let e0 = edge(x2, y1, y2, x1);
+            let e1 = edge(x0, y2, y0, x2);
+            let e2 = edge(x1, y0, y1, x0);
+            let any_neg = or(or(lt(e0, zero), lt(e1, zero)), lt(e2, zero));
+            let any_pos = or(or(lt(zero, e0), lt(zero, e1)), lt(zero, e2));
+            // `!all_nonzero`: an edge function is ±0 (NaN counts as non-zero).
+            let any_zero = or(or(is_zero(e0), is_zero(e1)), is_zero(e2));
+            let det = _mm256_add_ps(_mm256_add_ps(e0, e1), e2);
+            let t_num = _mm256_add_ps(
+                _mm256_add_ps(
+                    _mm256_mul_ps(e0, _mm256_mul_ps(z0, sz)),
+                    _mm256_mul_ps(e1, _mm256_mul_ps(z1, sz)),
+                ),
+                _mm256_mul_ps(e2, _mm256_mul_ps(z2, sz)),
+            );
+            // Both made positive by the determinant's sign, as the AVX-512 version.
+            let sign = _mm256_set1_ps(-0.0);
+            let t_num_p = _mm256_xor_ps(t_num, _mm256_and_ps(det, sign));
+            let det_p = _mm256_andnot_ps(sign, det);
+            let in_range = and(
+                lt(zero, t_num_p),
+                lt(t_num_p, _mm256_mul_ps(splat(t_max), det_p)),
+            );
+            let keep = _mm256_andnot_ps(and(any_neg, any_pos), or(any_zero, in_range));
+            let keep_bits = _mm256_movemask_ps(keep) as u32;
+            if keep_bits == 0 {
+                // Most halves: nothing crosses the segment.
+                continue;
+            }
+            // T's error bound from the largest |x|, |y|, |z| and |e|, as the per-triangle
+            // test computes it (exact maxima: the same values in any order).
+            let abs = |v| _mm256_andnot_ps(sign, v);
+            let max3 = |a, b, c| _mm256_max_ps(_mm256_max_ps(abs(a), abs(b)), abs(c));
+            let max_xy = _mm256_max_ps(max3(x0, x1, x2), max3(y0, y1, y2));
+            let bound = triangle::t_num_error_bound_in(
+                Lanes(max_xy),
+                Lanes(max3(z0, z1, z2)),
+                Lanes(max3(e0, e1, e2)),
+                Lanes(splat(r.sz.abs())),
+            )
+            .0;
+            let settled = _mm256_andnot_ps(
+                any_zero,
+                and(
+                    and(keep, in_range),
+                    and(lt(bound, t_num_p), lt(bound, splat(f32::INFINITY))),
+                ),
+            );
+            out.keep |= keep_bits << base;
+            out.settled |= (_mm256_movemask_ps(settled) as u32) << base;
+            _mm256_store_ps(out.e[0].as_mut_ptr().add(base), e0);
+            _mm256_store_ps(out.e[1].as_mut_ptr().add(base), e1);
+            _mm256_store_ps(out.e[2].as_mut_ptr().add(base), e2);
+            _mm256_store_ps(out.t_num.as_mut_ptr().add(base), t_num);
+        }
+    }
+    out
+}
+
+/// `lane_tests` in portable code (autovectorised), for targets without AVX2.
 #[cfg_attr(
-    all(target_arch = "x86_64", target_feature = "avx512f"),
+    all(
+        target_arch = "x86_64",
+        any(target_feature = "avx512f", target_feature = "avx2")
+    ),
     allow(dead_code)
 )]
 #[inline(always)]
@@ -338,7 +482,10 @@ fn lane_tests_portable(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
     out
 }
 
-#[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f")))]
+#[cfg(not(all(
+    target_arch = "x86_64",
+    any(target_feature = "avx512f", target_feature = "avx2")
+)))]
 #[inline(always)]
 fn lane_tests(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
     lane_tests_portable(c, r, t_max)
@@ -471,7 +618,7 @@ mod tests {
     #[test]
     fn lanes_keep_every_triangle_the_test_accepts_and_settle_as_it() {
         // Stronger than the agreement above: the filter alone never drops an accepted
-        // triangle, lane by lane, and (where AVX-512 is compiled) both versions agree.
+        // triangle, lane by lane, and (where AVX-512 or AVX2 is compiled) both versions agree.
         let mut s = 0xA076_1D64_78BD_642Fu64;
         let (mut accepted, mut settled) = (0, 0);
         // 64 triangles (full chunks) and 53 (eleven padding lanes).
