@@ -356,8 +356,7 @@ fn lane_tests(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
             let (x0, y0, z0) = vertex(0);
             let (x1, y1, z1) = vertex(1);
             let (x2, y2, z2) = vertex(2);
-            let edge =
-                |xa, yb, ya, xb| _mm256_sub_ps(_mm256_mul_ps(xa, yb), _mm256_mul_ps(ya, xb));
+            let edge = |xa, yb, ya, xb| _mm256_sub_ps(_mm256_mul_ps(xa, yb), _mm256_mul_ps(ya, xb));
             let e0 = edge(x2, y1, y2, x1);
             let e1 = edge(x0, y2, y0, x2);
             let e2 = edge(x1, y0, y1, x0);

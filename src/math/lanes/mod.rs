@@ -8,9 +8,10 @@
 //! both `f32` and `F32x16`, and the shared formulas (frames, warps, ray offsets, MIS weights)
 //! are written once against it.
 //!
-//! Two backends with the same types and semantics: `avx512` (one register per vector, used
-//! when the build enables AVX-512F, as `-C target-cpu=native` does on the development
-//! machine) and `portable` (arrays and loops, everywhere else). The tests check each
+//! Three backends with the same types and semantics: `avx512` (one register per vector, used
+//! when the build enables AVX-512F), `avx2` (two registers per vector, when the build enables
+//! AVX2 but not AVX-512F; `-C target-cpu=native` picks whichever the machine has) and
+//! `portable` (arrays and loops, everywhere else). The tests check each
 //! operation of both against the scalar one, NaNs, infinities and signed zeros included.
 
 mod mask;
@@ -21,21 +22,40 @@ mod vec3;
 #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
 pub mod avx512;
 
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    not(target_feature = "avx512f")
+))]
+pub mod avx2;
+
 pub use mask::{Mask8, Mask16};
 pub use real::Real;
 pub use vec3::V3;
 
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    not(target_feature = "avx512f")
+))]
+pub use avx2::{F32x16, F64x8, U32x16, U64x8};
 #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
 pub use avx512::{F32x16, F64x8, U32x16, U64x8};
-#[cfg(not(all(target_arch = "x86_64", target_feature = "avx512f")))]
+#[cfg(not(all(
+    target_arch = "x86_64",
+    any(target_feature = "avx512f", target_feature = "avx2")
+)))]
 pub use portable::{F32x16, F64x8, U32x16, U64x8};
 
 /// Lanes per vector.
 pub const LANES: usize = 16;
 
-/// True when the lane types compile to AVX-512 registers; false when they are the portable
-/// arrays (correct, but slower than scalar code).
-pub const NATIVE: bool = cfg!(all(target_arch = "x86_64", target_feature = "avx512f"));
+/// True when the lane types compile to vector registers (AVX-512 or AVX2); false when they
+/// are the portable arrays (correct, but slower than scalar code).
+pub const NATIVE: bool = cfg!(all(
+    target_arch = "x86_64",
+    any(target_feature = "avx512f", target_feature = "avx2")
+));
 
 /// Sixteen lanes of `T` as an array (lanes that a vector type does not cover: ids, flags).
 pub type Lanes<T> = [T; LANES];

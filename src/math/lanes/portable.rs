@@ -1,5 +1,5 @@
 //! The lane types as arrays and loops: the reference semantics of every lane operation, and
-//! the backend on machines without AVX-512 (where it is correct but slower than scalar code).
+//! the backend on machines without AVX2 or AVX-512 (where it is correct but slower than scalar code).
 
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Sub};
 

@@ -216,3 +216,9 @@ macro_rules! real_lanes {
 real_lanes!(portable::F32x16, portable::U32x16);
 #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
 real_lanes!(super::avx512::F32x16, super::avx512::U32x16);
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    not(target_feature = "avx512f")
+))]
+real_lanes!(super::avx2::F32x16, super::avx2::U32x16);

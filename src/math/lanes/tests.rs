@@ -93,6 +93,20 @@ impl LaneArray for avx512::F32x16 {
     }
 }
 
+#[cfg(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    not(target_feature = "avx512f")
+))]
+impl LaneArray for avx2::F32x16 {
+    fn from_array(a: [f32; 16]) -> Self {
+        avx2::F32x16::from_array(a)
+    }
+    fn to_array(self) -> [f32; 16] {
+        avx2::F32x16::to_array(self)
+    }
+}
+
 /// `T`'s arithmetic, comparisons and selects against the scalar operations.
 fn f32_operations_equal_scalar_ones<T: LaneArray>() {
     for (a, b) in pairs() {
@@ -151,6 +165,12 @@ fn f32_lane_operations_equal_scalar_ones() {
     f32_operations_equal_scalar_ones::<portable::F32x16>();
     #[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
     f32_operations_equal_scalar_ones::<avx512::F32x16>();
+    #[cfg(all(
+        target_arch = "x86_64",
+        target_feature = "avx2",
+        not(target_feature = "avx512f")
+    ))]
+    f32_operations_equal_scalar_ones::<avx2::F32x16>();
 }
 
 #[test]
