@@ -372,12 +372,12 @@ impl F32x16 {
     #[inline(always)]
     pub fn permute(self, idx: U32x16) -> F32x16 {
         unsafe {
-            let eight = _mm256_set1_epi32(8);
-            // Each half's indices pick from both halves (low three bits), then bit 3 chooses.
+            // Each half's indices pick from both halves (low three bits), then bit 3 chooses:
+            // shifted into the sign bit, which is all `blendv` reads.
             let half = |i: __m256i| {
                 let from_lo = _mm256_permutevar8x32_ps(self.lo, i);
                 let from_hi = _mm256_permutevar8x32_ps(self.hi, i);
-                let high = _mm256_cmpeq_epi32(_mm256_and_si256(i, eight), eight);
+                let high = _mm256_slli_epi32::<28>(i);
                 _mm256_blendv_ps(from_lo, from_hi, _mm256_castsi256_ps(high))
             };
             F32x16::both(half(idx.lo), half(idx.hi))
