@@ -50,11 +50,22 @@ impl BoundArithmetic for F32x16 {
 /// 11 hold the record's identity, lanes 12–15 are unused).
 type PacketTriangle = [f32; LANES];
 
+/// True where each triangle is also kept as one vector per vertex (its x, y, z in lanes 0–2),
+/// read by `F32x16::permute_low8`: with AVX2 (two registers per vector) a permutation within
+/// the low eight lanes is one instruction per half, one across all sixteen four.
+const BY_VERTEX: bool = cfg!(all(
+    target_arch = "x86_64",
+    target_feature = "avx2",
+    not(target_feature = "avx512f")
+));
+
 /// The records of a small scene, one vector each, for the sixteen-ray tests, and their
 /// vertex normals for the surface data.
 #[derive(Clone, Default)]
 pub struct PacketTriangles {
     triangles: Vec<PacketTriangle>,
+    /// With `BY_VERTEX`, per record: vertex j's coordinates in lanes 0–2 of vector j.
+    by_vertex: Vec<[PacketTriangle; 3]>,
     /// Per record, the three vertex normals' coordinates (n0.x, n0.y, …, n2.z; zero for a
     /// mesh without normals), when some mesh has them.
     normals: Option<Vec<f32>>,
@@ -72,12 +83,32 @@ impl PacketTriangles {
                 v
             })
             .collect();
+        let by_vertex = if BY_VERTEX {
+            records
+                .iter()
+                .map(|r| {
+                    std::array::from_fn(|j| {
+                        let mut v = [0.0f32; LANES];
+                        for (k, row) in r.rows.iter().enumerate() {
+                            v[k] = row[j];
+                        }
+                        v
+                    })
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
         let normals = normals.map(|n| {
             n.iter()
                 .flat_map(|tri| tri.iter().flat_map(|v| v.to_array()))
                 .collect()
         });
-        PacketTriangles { triangles, normals }
+        PacketTriangles {
+            triangles,
+            by_vertex,
+            normals,
+        }
     }
 }
 
@@ -180,6 +211,8 @@ impl WideRays {
 struct TriangleRayLanes {
     /// For vertex j: the lanes of its kx, ky and kz coordinates.
     index: [[U32x16; 3]; 3],
+    /// kx, ky and kz (the lanes of a vertex's coordinates in a `by_vertex` vector).
+    axis: [U32x16; 3],
     ox: F32x16,
     oy: F32x16,
     oz: F32x16,
@@ -210,6 +243,7 @@ impl TriangleRayLanes {
             (lanes_of(kx), lanes_of(ky), lanes_of(kz));
         TriangleRayLanes {
             index: std::array::from_fn(|j| [ix[j], iy[j], iz[j]]),
+            axis: [kx, ky, kz],
             ox: pick(o, kx),
             oy: pick(o, ky),
             oz: pick(o, kz),
@@ -271,12 +305,25 @@ struct LaneTests {
     in_range: Mask16,
 }
 
-/// The watertight test of `tri` against the lanes of `m`, within (0, t_max) per lane, up to
-/// the error bound of T (`settled`).
+/// The watertight test of record `record` against the lanes of `m`, within (0, t_max) per
+/// lane, up to the error bound of T (`settled`).
 #[inline(always)]
-fn lane_tests(tri: &PacketTriangle, r: &TriangleRayLanes, t_max: F32x16, m: Mask16) -> LaneTests {
-    let v = F32x16::from_array(*tri);
-    let sheared = shear(r, |k, j| v.permute(r.index[j][k]));
+fn lane_tests(
+    triangles: &PacketTriangles,
+    record: usize,
+    r: &TriangleRayLanes,
+    t_max: F32x16,
+    m: Mask16,
+) -> LaneTests {
+    let sheared = if BY_VERTEX {
+        let v = triangles.by_vertex[record]
+            .each_ref()
+            .map(|a| F32x16::from_array(*a));
+        shear(r, |k, j| v[j].permute_low8(r.axis[k]))
+    } else {
+        let v = F32x16::from_array(triangles.triangles[record]);
+        shear(r, |k, j| v.permute(r.index[j][k]))
+    };
     let [e0, e1, e2] = sheared.e;
     let [z0, z1, z2] = sheared.z;
     let zero = F32x16::splat(0.0);
@@ -376,8 +423,8 @@ impl PacketTriangles {
             e: [[0.0; 3]; LANES],
             det: [0.0; LANES],
         };
-        for (k, tri) in self.triangles.iter().enumerate() {
-            let lanes = lane_tests(tri, r, best.t, m);
+        for k in 0..self.triangles.len() {
+            let lanes = lane_tests(self, k, r, best.t, m);
             if lanes.candidate.none() {
                 continue;
             }
@@ -440,12 +487,12 @@ impl PacketTriangles {
         m: Mask16,
     ) -> Mask16 {
         let mut found = Mask16::NONE;
-        for (k, tri) in self.triangles.iter().enumerate() {
+        for k in 0..self.triangles.len() {
             let open = m & !found;
             if open.none() {
                 break;
             }
-            let lanes = lane_tests(tri, r, t_max, open);
+            let lanes = lane_tests(self, k, r, t_max, open);
             if lanes.candidate.none() {
                 continue;
             }

@@ -384,6 +384,18 @@ impl F32x16 {
         }
     }
 
+    /// Lane i of the result is lane `idx[i] mod 8` of `self` (only lanes 0–7 are read): one
+    /// instruction per half, where `permute` needs four.
+    #[inline(always)]
+    pub fn permute_low8(self, idx: U32x16) -> F32x16 {
+        unsafe {
+            F32x16::both(
+                _mm256_permutevar8x32_ps(self.lo, idx.lo),
+                _mm256_permutevar8x32_ps(self.lo, idx.hi),
+            )
+        }
+    }
+
     /// Lanes 0–7 and 8–15 widened to f64 (exact).
     #[inline(always)]
     pub fn to_f64_halves(self) -> (F64x8, F64x8) {

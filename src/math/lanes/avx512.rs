@@ -233,6 +233,12 @@ impl F32x16 {
         F32x16(unsafe { _mm512_permutexvar_ps(idx.0, self.0) })
     }
 
+    /// Lane i of the result is lane `idx[i] mod 8` of `self` (only lanes 0–7 are read).
+    #[inline(always)]
+    pub fn permute_low8(self, idx: U32x16) -> F32x16 {
+        self.permute(idx & U32x16::splat(7))
+    }
+
     /// Lanes 0–7 and 8–15 widened to f64 (exact).
     #[inline(always)]
     pub fn to_f64_halves(self) -> (F64x8, F64x8) {

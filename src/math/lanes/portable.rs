@@ -220,6 +220,12 @@ impl F32x16 {
         F32x16(std::array::from_fn(|i| self.0[idx.0[i] as usize % 16]))
     }
 
+    /// Lane i of the result is lane `idx[i] mod 8` of `self` (only lanes 0–7 are read).
+    #[inline(always)]
+    pub fn permute_low8(self, idx: U32x16) -> F32x16 {
+        F32x16(std::array::from_fn(|i| self.0[idx.0[i] as usize % 8]))
+    }
+
     /// Lanes 0–7 and 8–15 widened to f64 (exact).
     #[inline(always)]
     pub fn to_f64_halves(self) -> (F64x8, F64x8) {

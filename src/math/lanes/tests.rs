@@ -292,6 +292,16 @@ fn integer_lane_operations_equal_scalar_ones() {
         for i in 0..16 {
             assert_eq!(p[i], (a[i] % 16) as f32 * 0.5);
         }
+        let p8 = f.permute_low8(x).to_array();
+        let p8_portable = portable::F32x16(f.to_array())
+            .permute_low8(portable::U32x16(a))
+            .0;
+        for i in 0..16 {
+            assert_eq!(
+                (p8[i], p8_portable[i]),
+                ((a[i] % 8) as f32 * 0.5, (a[i] % 8) as f32 * 0.5)
+            );
+        }
         for i in 0..16 {
             assert_eq!(x.lt(y).get(i), a[i] < b[i]);
             assert_eq!(x.eq(y).get(i), a[i] == b[i]);
