@@ -423,7 +423,8 @@ impl PacketTriangles {
             e: [[0.0; 3]; LANES],
             det: [0.0; LANES],
         };
-        for k in 0..self.triangles.len() {
+        // One record per triangle, in the same order.
+        for (k, record) in records.iter().enumerate().take(self.triangles.len()) {
             let lanes = lane_tests(self, k, r, best.t, m);
             if lanes.candidate.none() {
                 continue;
@@ -443,7 +444,7 @@ impl PacketTriangles {
             scalar.lanes &= !settled;
             for i in ((lanes.candidate & !lanes.in_range) | (closer & !settled)).lanes() {
                 let t_max_i = best.t.to_array()[i];
-                if let Some(h) = triangle::intersect(&records[k], &tri_ray(i), t_max_i) {
+                if let Some(h) = triangle::intersect(record, &tri_ray(i), t_max_i) {
                     let m = Mask16(1 << i);
                     best.t = F32x16::select(m, F32x16::splat(h.t), best.t);
                     best.record = U32x16::select(m, U32x16::splat(k as u32), best.record);
@@ -487,7 +488,8 @@ impl PacketTriangles {
         m: Mask16,
     ) -> Mask16 {
         let mut found = Mask16::NONE;
-        for k in 0..self.triangles.len() {
+        // One record per triangle, in the same order.
+        for (k, record) in records.iter().enumerate().take(self.triangles.len()) {
             let open = m & !found;
             if open.none() {
                 break;
@@ -500,7 +502,7 @@ impl PacketTriangles {
             found |= settled & lanes.t().lt(t_max);
             for i in (lanes.candidate & !settled).lanes() {
                 let t_max_i = t_max.to_array()[i];
-                if triangle::intersect(&records[k], &tri_ray(i), t_max_i).is_some() {
+                if triangle::intersect(record, &tri_ray(i), t_max_i).is_some() {
                     found.set(i, true);
                 }
             }
