@@ -20,7 +20,8 @@ use crate::geometry::Ray;
 use crate::material::TransportMode;
 use crate::math::Rgb;
 use crate::path::camera_connection::{self, adjoint_shading_factor};
-use crate::path::mis::{Heuristic, PathDensity, StrategyRules, strategy_weight};
+use crate::path::mis::{Heuristic, PathDensity, StrategyRules};
+use crate::path::mis_sums::{Joint, SubpathSums, joint_weight};
 use crate::path::next_event::{self, LightChoice};
 use crate::path::subpath::LightStart;
 use crate::path::vertex::{Vertex, VertexKind};
@@ -202,12 +203,50 @@ fn light_vertex_to_camera<'a>(
     })
 }
 
-/// Fills `out` with the densities of the complete path strategy (s, t) made (x0 … x(s+t−1),
-/// light to camera), the endpoints replaced by what the strategy sampled (`sampled`) and
-/// the densities the connection creates computed here; returns the strategy rules that
-/// the path's light imposes (with `heuristic` and `hide_emitters`).
+/// The partial weight sums of a camera sample's two subpaths (`mis_sums`), filled once
+/// after they are traced; every strategy's weight then costs O(1) (`weight`).
+#[derive(Clone, Debug, Default)]
+pub struct SubpathWeights {
+    light: SubpathSums,
+    camera: SubpathSums,
+}
+
+impl SubpathWeights {
+    /// Fills the sums of `light_path` and `camera_path` as `mis` sees their vertices: a
+    /// vertex connectible when a connection may end there (the light's own vertex always).
+    pub fn fill(&mut self, light_path: &[Vertex], camera_path: &[Vertex], heuristic: Heuristic) {
+        let light_hittable = light_path.first().is_some_and(|v| !v.is_delta_light());
+        self.light.fill_light(
+            light_path.iter().enumerate().map(|(i, v)| PathDensity {
+                from_light: v.pdf_fwd,
+                from_camera: v.pdf_rev,
+                connectible: i == 0 || connectible(v),
+            }),
+            light_hittable,
+            heuristic,
+        );
+        self.camera.fill_camera(
+            camera_path.iter().map(|v| PathDensity {
+                from_light: v.pdf_rev,
+                from_camera: v.pdf_fwd,
+                connectible: connectible(v),
+            }),
+            heuristic,
+        );
+    }
+}
+
+/// A connection may end at `v` (the walk did not leave it through a delta component).
+fn connectible(v: &Vertex) -> bool {
+    !v.delta && v.is_connectible()
+}
+
+/// The densities strategy (s, t) gives the two vertices on each side of its joint
+/// (`mis_sums::Joint`), the endpoints replaced by what the strategy sampled (`sampled`) and
+/// the densities the connection creates computed here; with the strategy rules that the
+/// path's light imposes (with `heuristic` and `hide_emitters`).
 #[allow(clippy::too_many_arguments)]
-pub fn path_densities(
+fn joint(
     scene: &Scene,
     light_path: &[Vertex],
     camera_path: &[Vertex],
@@ -216,8 +255,7 @@ pub fn path_densities(
     t: usize,
     heuristic: Heuristic,
     hide_emitters: bool,
-    out: &mut Vec<PathDensity>,
-) -> StrategyRules {
+) -> (Joint, StrategyRules) {
     // The strategy's endpoints as vertices (the sampled one where there is one).
     let light_end = |i: usize| match sampled {
         Some(Sampled {
@@ -233,65 +271,61 @@ pub fn path_densities(
         }) if i == 0 => vertex,
         _ => &camera_path[i],
     };
-    let connectible = |v: &Vertex| !v.delta && v.is_connectible();
-    out.clear();
-    for i in 0..s {
-        let v = light_end(i);
-        out.push(PathDensity {
-            from_light: v.pdf_fwd,
-            from_camera: v.pdf_rev,
-            connectible: i == 0 || connectible(v),
-        });
-    }
-    for i in (0..t).rev() {
-        let v = camera_end(i);
-        out.push(PathDensity {
-            from_light: v.pdf_rev,
-            from_camera: v.pdf_fwd,
-            connectible: connectible(v),
-        });
-    }
-    // The connection's endpoints: whatever their walks sampled next, the path leaves them
-    // along the connection, through non-delta components.
     let pt = camera_end(t - 1);
     let pt_minus = (t >= 2).then(|| camera_end(t - 2));
     let qs = (s >= 1).then(|| light_end(s - 1));
     let qs_minus = (s >= 2).then(|| light_end(s - 2));
-    out[s].connectible = true;
-    if s >= 1 {
-        out[s - 1].connectible = true;
-    }
-    // The densities the connection creates: of pt from the light side, of pt_minus from
-    // pt; of qs from the camera side, of qs_minus from qs.
-    out[s].from_light = match qs {
-        Some(qs) => qs.pdf(scene, qs_minus, pt),
-        None => pt.pdf_light_origin(scene, pt.direction_to(pt_minus.expect("s = 0 has t ≥ 2"))),
-    };
-    if let Some(pt_minus) = pt_minus {
-        out[s + 1].from_light = match qs {
-            Some(qs) => pt.pdf(scene, Some(qs), pt_minus),
-            None => pt.pdf_light_direction(scene, pt_minus),
-        };
-    }
-    if let Some(qs) = qs {
-        out[s - 1].from_camera = pt.pdf(scene, pt_minus, qs);
-        if let Some(qs_minus) = qs_minus {
-            out[s - 2].from_camera = qs.pdf(scene, Some(pt), qs_minus);
-        }
-    }
+    // Whatever their walks sampled next, the path leaves the connection's endpoints along
+    // the connection, through non-delta components: both are connectible. The densities
+    // the connection creates: of pt from the light side, of pt_minus from pt; of qs from
+    // the camera side, of qs_minus from qs.
+    let camera = [
+        Some(PathDensity {
+            from_light: match qs {
+                Some(qs) => qs.pdf(scene, qs_minus, pt),
+                None => {
+                    pt.pdf_light_origin(scene, pt.direction_to(pt_minus.expect("s = 0 has t ≥ 2")))
+                }
+            },
+            from_camera: pt.pdf_fwd,
+            connectible: true,
+        }),
+        pt_minus.map(|pt_minus| PathDensity {
+            from_light: match qs {
+                Some(qs) => pt.pdf(scene, Some(qs), pt_minus),
+                None => pt.pdf_light_direction(scene, pt_minus),
+            },
+            from_camera: pt_minus.pdf_fwd,
+            connectible: connectible(pt_minus),
+        }),
+    ];
+    let light = [
+        qs.map(|qs| PathDensity {
+            from_light: qs.pdf_fwd,
+            from_camera: pt.pdf(scene, pt_minus, qs),
+            connectible: true,
+        }),
+        qs_minus.map(|qs_minus| PathDensity {
+            from_light: qs_minus.pdf_fwd,
+            from_camera: qs.expect("s ≥ 2").pdf(scene, Some(pt), qs_minus),
+            connectible: s == 2 || connectible(qs_minus),
+        }),
+    ];
     let x0 = if s >= 1 { light_end(0) } else { pt };
     let finite_area_light = matches!(x0.kind, VertexKind::Surface { .. })
         || matches!(x0.kind, VertexKind::Light { delta: false, .. });
-    StrategyRules {
+    let rules = StrategyRules {
         heuristic,
         hide_emitters,
         light_hittable: !x0.is_delta_light(),
         light_seen_by_camera: finite_area_light,
-    }
+    };
+    (Joint { light, camera }, rules)
 }
 
-/// The weight of strategy (s, t) for the path it made (`path_densities`, then
-/// `mis::strategy_weight`); `scratch` is reused between calls.
+/// The weight of strategy (s, t) for the path it made: `mis::strategy_weight` over the
+/// complete path (Veach 1997, eq. 10.9), computed from the joint's densities and the
+/// subpaths' partial sums (`sums`, filled for these subpaths with this heuristic).
 #[allow(clippy::too_many_arguments)]
 pub fn weight(
     scene: &Scene,
@@ -302,9 +336,9 @@ pub fn weight(
     t: usize,
     heuristic: Heuristic,
     hide_emitters: bool,
-    scratch: &mut Vec<PathDensity>,
+    sums: &SubpathWeights,
 ) -> f32 {
-    let rules = path_densities(
+    let (joint, rules) = joint(
         scene,
         light_path,
         camera_path,
@@ -313,7 +347,6 @@ pub fn weight(
         t,
         heuristic,
         hide_emitters,
-        scratch,
     );
-    strategy_weight(scratch, s, &rules)
+    joint_weight(&joint, &sums.light, &sums.camera, s, t, &rules)
 }

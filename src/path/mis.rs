@@ -83,16 +83,20 @@ impl StrategyRules {
     fn can_make(&self, path: &[PathDensity], s: usize) -> bool {
         let n = path.len();
         debug_assert!(s < n, "strategies keep at least one camera vertex");
+        let before = s.checked_sub(1).is_some_and(|i| path[i].connectible);
+        self.can_make_joining(n, s, before, path[s].connectible)
+    }
+
+    /// `can_make` for a path of `n` vertices given only whether x(s−1) and x(s), the
+    /// vertices strategy s joins, are connectible (`before` is unused for s = 0).
+    #[inline(always)]
+    pub fn can_make_joining(&self, n: usize, s: usize, before: bool, after: bool) -> bool {
         if n == 2 && self.hide_emitters {
             return false;
         }
         match s {
             0 => self.light_hittable,
-            _ => {
-                path[s - 1].connectible
-                    && path[s].connectible
-                    && !(n == 2 && s == 1 && !self.light_seen_by_camera)
-            }
+            _ => before && after && !(n == 2 && s == 1 && !self.light_seen_by_camera),
         }
     }
 }
@@ -143,15 +147,16 @@ pub fn strategy_weight(path: &[PathDensity], s: usize, rules: &StrategyRules) ->
     if w.is_finite() { w as f32 } else { 0.0 }
 }
 
-/// A positive ratio m·2^e, m kept within [2⁻²⁵⁶, 2²⁵⁶]: a product of path densities that no
-/// f64 overflow or underflow cuts short.
+/// A non-negative ratio m·2^e, m kept within [2⁻²⁵⁶, 2²⁵⁶] (or 0): a product of path
+/// densities, or a sum of such products, that no f64 overflow or underflow cuts short.
 #[derive(Clone, Copy, Debug)]
-struct ScaledRatio {
+pub(super) struct ScaledRatio {
     m: f64,
     e: i32,
 }
 
 impl ScaledRatio {
+    pub(super) const ZERO: ScaledRatio = ScaledRatio { m: 0.0, e: 0 };
     const ONE: ScaledRatio = ScaledRatio { m: 1.0, e: 0 };
     /// 2²⁵⁶.
     const LIMIT: f64 = 1.157_920_892_373_162e77;
@@ -167,10 +172,63 @@ impl ScaledRatio {
         true
     }
 
+    /// self × r for r ≥ 0: exactly 0 for r = 0 (whatever self is), ∞ or NaN kept (they
+    /// make the weight that reads them 0).
+    #[inline(always)]
+    pub(super) fn scaled(self, r: f64) -> ScaledRatio {
+        if r == 0.0 {
+            return ScaledRatio::ZERO;
+        }
+        if self.m == 0.0 {
+            // 0 × ∞ is NaN: an infinite ratio makes the weight 0 even over an empty sum,
+            // as `strategy_weight` has it.
+            return ScaledRatio {
+                m: self.m * r,
+                e: 0,
+            };
+        }
+        let mut out = ScaledRatio {
+            m: self.m * r,
+            e: self.e,
+        };
+        if out.m > Self::LIMIT || out.m < 1.0 / Self::LIMIT {
+            out.rescale();
+        }
+        out
+    }
+
+    /// self + 1.
+    #[inline(always)]
+    pub(super) fn plus_one(self) -> ScaledRatio {
+        let m = match self.e {
+            0 => self.m + 1.0,
+            // 1 in units of 2^e (0 once it is below f64's range: negligible beside m).
+            e if e > 0 => {
+                return ScaledRatio {
+                    m: self.m + 2f64.powi(-e),
+                    e,
+                };
+            }
+            // self < 1 (m ≤ 2²⁵⁶, e ≤ −256): plain f64 holds the sum.
+            e => self.m * 2f64.powi(e) + 1.0,
+        };
+        let mut out = ScaledRatio { m, e: 0 };
+        if m > Self::LIMIT {
+            out.rescale();
+        }
+        out
+    }
+
+    /// The value as an f64 (∞ or 0 where it leaves f64's range).
+    #[inline(always)]
+    pub(super) fn value(self) -> f64 {
+        self.heuristic(false)
+    }
+
     /// Moves powers of 2²⁵⁶ from m to e; false for an infinite or NaN m.
     #[cold]
     fn rescale(&mut self) -> bool {
-        if !self.m.is_finite() {
+        if !self.m.is_finite() || self.m == 0.0 {
             return false;
         }
         while self.m > Self::LIMIT {

@@ -7,6 +7,7 @@
 pub mod camera_connection;
 pub mod connection;
 pub mod mis;
+pub mod mis_sums;
 pub mod next_event;
 pub mod random_walk;
 pub mod settings;

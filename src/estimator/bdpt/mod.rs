@@ -26,9 +26,8 @@ use crate::error::{Error, Result};
 use crate::film::{Film, SplatList};
 use crate::geometry::Ray;
 use crate::math::Rgb;
-use crate::path::connection::{self, Sampled};
+use crate::path::connection::{self, Sampled, SubpathWeights};
 pub use crate::path::mis::Heuristic;
-use crate::path::mis::PathDensity;
 use crate::path::settings::PathSettings;
 use crate::path::subpath::{camera_subpath, light_subpath};
 use crate::path::vertex::Vertex;
@@ -151,7 +150,7 @@ pub struct BdptTile {
 pub struct Scratch<'a> {
     camera_path: Vec<Vertex<'a>>,
     light_path: Vec<Vertex<'a>>,
-    densities: Vec<PathDensity>,
+    weights: SubpathWeights,
 }
 
 impl<'a> Scratch<'a> {
@@ -213,7 +212,7 @@ impl BdptSample {
         let Scratch {
             camera_path,
             light_path,
-            densities,
+            weights,
         } = scratch;
         let (rays, invalid) = counts;
         let rr_depth = self.settings.path.rr_depth;
@@ -227,6 +226,7 @@ impl BdptSample {
         *rays += light_rays;
         sampler.start_stream(Stream::Connect);
         let settings = &self.settings;
+        weights.fill(light_path, camera_path, settings.mis);
         let max_vertices = camera_vertices.saturating_add(1);
         let mut pixel = Rgb::BLACK;
         for t in 1..=camera_path.len() {
@@ -254,8 +254,8 @@ impl BdptSample {
                     *invalid += 1;
                     continue;
                 }
-                // Visibility before the weight: the weight's O(s + t) densities are spent
-                // only on connections that carry light.
+                // Visibility before the weight: the weight's densities are spent only on
+                // connections that carry light.
                 if let Some(shadow) = &c.shadow {
                     *rays += 1;
                     if scene.geometry.occluded(shadow) {
@@ -271,7 +271,7 @@ impl BdptSample {
                     t,
                     settings.mis,
                     hide,
-                    densities,
+                    weights,
                 );
                 let value = c.value * w;
                 if value.is_black() && !every_strategy {

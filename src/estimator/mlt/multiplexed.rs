@@ -21,8 +21,7 @@
 use crate::estimator::bdpt::Heuristic;
 use crate::estimator::camera_pass::camera_ray_in_image;
 use crate::estimator::mlt::target::{Contributions, Evaluation, PathTarget};
-use crate::path::connection;
-use crate::path::mis::PathDensity;
+use crate::path::connection::{self, SubpathWeights};
 use crate::path::settings::PathSettings;
 use crate::path::subpath::{camera_subpath, light_subpath};
 use crate::path::vertex::Vertex;
@@ -47,7 +46,7 @@ pub struct MultiplexedTarget {
 pub struct MultiplexedScratch<'a> {
     camera_path: Vec<Vertex<'a>>,
     light_path: Vec<Vertex<'a>>,
-    densities: Vec<PathDensity>,
+    weights: SubpathWeights,
 }
 
 impl MultiplexedTarget {
@@ -132,7 +131,7 @@ impl PathTarget for MultiplexedTarget {
         let MultiplexedScratch {
             camera_path,
             light_path,
-            densities,
+            weights,
         } = scratch;
         let (raster, ray) = camera_ray_in_image(
             &scene.camera,
@@ -176,13 +175,14 @@ impl PathTarget for MultiplexedTarget {
         if c.value.is_black() {
             return eval;
         }
-        // Visibility before the weight (whose densities cost O(d)).
+        // Visibility before the weight (whose subpath sums cost O(d)).
         if let Some(shadow) = &c.shadow {
             eval.rays += 1;
             if scene.geometry.occluded(shadow) {
                 return eval;
             }
         }
+        weights.fill(light_path, camera_path, self.mis);
         let w = connection::weight(
             scene,
             light_path,
@@ -192,7 +192,7 @@ impl PathTarget for MultiplexedTarget {
             t,
             self.mis,
             hide,
-            densities,
+            weights,
         );
         let value = c.value * (w * (strategies as f64 / pick) as f32);
         out.push(c.raster.unwrap_or(raster), value, &mut eval.invalid);

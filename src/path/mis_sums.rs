@@ -1,0 +1,267 @@
+//! The weights of `mis::strategy_weight` at O(1) cost per strategy: partial sums carried
+//! along each subpath, so that a bidirectional estimator that tries every (s, t) of a
+//! camera sample does not walk the whole path once per connection.
+//!
+//! `strategy_weight` is w_s = 1 / (1 + L(s) + R(s)) with
+//! L(s) = Σ_{j<s} [j can make the path] Π_{i=j}^{s−1} ρ_i,  ρ_i = from_camera(xi) / from_light(xi),
+//! R(s) = Σ_{j>s} [j can make the path] Π_{i=s}^{j−1} σ_i,  σ_i = from_light(xi) / from_camera(xi)
+//! (Veach 1997, eqs. 10.9 and 10.10; each ratio squared for the power heuristic). Written
+//! inside out, L(s) = ρ_(s−1) (c_(s−1) + ρ_(s−2) (c_(s−2) + ρ_(s−3) (…))), c_j the indicator
+//! of strategy j. A connection changes only the densities of the two vertices on each side
+//! of the joint (x(s−2) … x(s+1)); everything deeper belongs to one subpath and is the same
+//! for every strategy that uses it. So each subpath keeps, per vertex k, the partial sum
+//! G_k = c_k + ρ_(k−1) G_(k−1) (light side; mirrored on the camera side), computed once
+//! per subpath, and a strategy adds its joint's two factors on each side. The same
+//! recursion underlies the weights of Georgiev et al. 2012 ("Light transport simulation
+//! with vertex connection and merging", §4 and its technical report), here over the path
+//! density records of `mis` rather than subpath-specific quantities, so every rule of
+//! `StrategyRules` carries over unchanged. Sums are kept scaled (`ScaledRatio`) so that
+//! no f64 overflow or underflow of a partial product changes a weight.
+
+use crate::path::mis::{Heuristic, PathDensity, ScaledRatio, StrategyRules};
+
+/// ρ = num / den in f64 (squared for the power heuristic); exactly 0 when num is 0 (every
+/// strategy beyond that vertex is impossible, whatever den), ∞ when only den is.
+#[inline(always)]
+fn ratio(num: f32, den: f32, power: bool) -> f64 {
+    if num == 0.0 {
+        return 0.0;
+    }
+    let r = num as f64 / den as f64;
+    if power { r * r } else { r }
+}
+
+/// One subpath's partial sums, one per vertex (see the module comment).
+#[derive(Clone, Debug, Default)]
+pub struct SubpathSums {
+    sums: Vec<ScaledRatio>,
+}
+
+impl SubpathSums {
+    /// A light subpath x0 x1 … as `mis` sees its vertices (from_light its own sampling
+    /// density, from_camera the reverse one, `connectible` the light side's rule), with
+    /// x0's strategy s = 0 possible or not (`light_hittable`): G_0 = c_0,
+    /// G_k = c_k + ρ_(k−1) G_(k−1).
+    pub fn fill_light(
+        &mut self,
+        vertices: impl Iterator<Item = PathDensity>,
+        light_hittable: bool,
+        heuristic: Heuristic,
+    ) {
+        let power = heuristic == Heuristic::Power;
+        self.sums.clear();
+        let mut g = ScaledRatio::ZERO;
+        let mut previous: Option<PathDensity> = None;
+        for v in vertices {
+            let c = match previous {
+                None => light_hittable,
+                Some(p) => {
+                    g = g.scaled(ratio(p.from_camera, p.from_light, power));
+                    p.connectible && v.connectible
+                }
+            };
+            if c {
+                g = g.plus_one();
+            }
+            self.sums.push(g);
+            previous = Some(v);
+        }
+    }
+
+    /// A camera subpath z0 z1 … (z0 the camera; from_camera its own sampling density,
+    /// from_light the reverse one): H_0 = 0, H_1 = c'_1, H_m = c'_m + σ_(m−1) H_(m−1), c'_m
+    /// the indicator of the strategy with m camera vertices.
+    pub fn fill_camera(
+        &mut self,
+        vertices: impl Iterator<Item = PathDensity>,
+        heuristic: Heuristic,
+    ) {
+        let power = heuristic == Heuristic::Power;
+        self.sums.clear();
+        let mut h = ScaledRatio::ZERO;
+        let mut previous: Option<PathDensity> = None;
+        for v in vertices {
+            if let Some(p) = previous {
+                // H_0 = 0 is never multiplied: z0's ratio belongs to no strategy.
+                if self.sums.len() >= 2 {
+                    h = h.scaled(ratio(p.from_light, p.from_camera, power));
+                }
+                if p.connectible && v.connectible {
+                    h = h.plus_one();
+                }
+            }
+            self.sums.push(h);
+            previous = Some(v);
+        }
+    }
+}
+
+/// The vertices on both sides of strategy s's joint as the complete path sees them, the
+/// densities the connection created included: x(s−1), x(s−2) on the light side and x(s),
+/// x(s+1) on the camera side (None where the path has no such vertex).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Joint {
+    pub light: [Option<PathDensity>; 2],
+    pub camera: [Option<PathDensity>; 2],
+}
+
+/// The weight of strategy (s, t) for its path of s + t vertices, from its joint and the
+/// partial sums of the light subpath (its first s − 2 vertices are read) and of the camera
+/// subpath (its first t − 2): `mis::strategy_weight` of the same path, up to rounding.
+pub fn joint_weight(
+    joint: &Joint,
+    light: &SubpathSums,
+    camera: &SubpathSums,
+    s: usize,
+    t: usize,
+    rules: &StrategyRules,
+) -> f32 {
+    let n = s + t;
+    let power = rules.heuristic == Heuristic::Power;
+    let conn = |v: Option<PathDensity>| v.is_some_and(|v| v.connectible);
+    let [x_s1, x_s2] = joint.light;
+    let [x_s, x_sp1] = joint.camera;
+    if t == 0 || !rules.can_make_joining(n, s, conn(x_s1), conn(x_s)) {
+        return 0.0;
+    }
+    // L(s) = ρ_(s−1) (c_(s−1) + ρ_(s−2) G_(s−2)).
+    let left = match (x_s1, s) {
+        (Some(a), s) if s >= 1 => {
+            let inner = match x_s2 {
+                Some(b) if s >= 2 => {
+                    light.sums[s - 2].scaled(ratio(b.from_camera, b.from_light, power))
+                }
+                _ => ScaledRatio::ZERO,
+            };
+            let inner = if rules.can_make_joining(n, s - 1, conn(x_s2), a.connectible) {
+                inner.plus_one()
+            } else {
+                inner
+            };
+            inner.scaled(ratio(a.from_camera, a.from_light, power))
+        }
+        _ => ScaledRatio::ZERO,
+    };
+    // R(s) = σ_s (c_(s+1) + σ_(s+1) H_(t−2)), H_0 = 0 unread (t = 2).
+    let right = match (x_s, x_sp1) {
+        (Some(a), Some(b)) if t >= 2 => {
+            let inner = if t >= 3 {
+                camera.sums[t - 2].scaled(ratio(b.from_light, b.from_camera, power))
+            } else {
+                ScaledRatio::ZERO
+            };
+            let inner = if rules.can_make_joining(n, s + 1, a.connectible, b.connectible) {
+                inner.plus_one()
+            } else {
+                inner
+            };
+            inner.scaled(ratio(a.from_light, a.from_camera, power))
+        }
+        _ => ScaledRatio::ZERO,
+    };
+    let w = 1.0 / (1.0 + left.value() + right.value());
+    if w.is_finite() { w as f32 } else { 0.0 }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::path::mis::strategy_weight;
+    use rand::{RngExt, SeedableRng};
+    use rand_xoshiro::Xoshiro256PlusPlus;
+
+    /// `joint_weight` of strategy s on a complete path given as `mis` records: the light
+    /// subpath is path[..s], the camera subpath path[s..] reversed, the joint the records
+    /// around s.
+    fn recursive_weight(path: &[PathDensity], s: usize, rules: &StrategyRules) -> f32 {
+        let n = path.len();
+        let t = n - s;
+        let mut light = SubpathSums::default();
+        light.fill_light(
+            path[..s].iter().copied(),
+            rules.light_hittable,
+            rules.heuristic,
+        );
+        let mut camera = SubpathSums::default();
+        camera.fill_camera(path[s..].iter().rev().copied(), rules.heuristic);
+        let at = |i: Option<usize>| i.and_then(|i| path.get(i).copied());
+        let joint = Joint {
+            light: [at(s.checked_sub(1)), at(s.checked_sub(2))],
+            camera: [at(Some(s)), at((t >= 2).then_some(s + 1))],
+        };
+        joint_weight(&joint, &light, &camera, s, t, rules)
+    }
+
+    fn assert_same_weights(path: &[PathDensity], rules: &StrategyRules, what: &str) {
+        for s in 0..path.len() {
+            let direct = strategy_weight(path, s, rules);
+            let recursive = recursive_weight(path, s, rules);
+            let tolerance = 1e-5 * direct.max(1e-30);
+            assert!(
+                (direct - recursive).abs() <= tolerance,
+                "{what}, s = {s}: strategy_weight {direct}, recursive {recursive}"
+            );
+        }
+    }
+
+    #[test]
+    fn the_recursive_weights_are_those_of_strategy_weight_on_random_paths() {
+        let mut rng = Xoshiro256PlusPlus::seed_from_u64(17);
+        for case in 0..4000 {
+            let n = rng.random_range(2..12);
+            let density = |rng: &mut Xoshiro256PlusPlus| match rng.random_range(0..10) {
+                0 => 0.0,
+                1 => 10f32.powf(rng.random_range(-30.0..30.0)),
+                _ => rng.random_range(0.01..5.0),
+            };
+            let path: Vec<PathDensity> = (0..n)
+                .map(|_| PathDensity {
+                    from_light: density(&mut rng),
+                    from_camera: density(&mut rng),
+                    connectible: rng.random_range(0..5) > 0,
+                })
+                .collect();
+            for heuristic in [Heuristic::Balance, Heuristic::Power] {
+                let rules = StrategyRules {
+                    heuristic,
+                    hide_emitters: rng.random_range(0..4) == 0,
+                    light_hittable: rng.random_range(0..3) > 0,
+                    light_seen_by_camera: rng.random_range(0..3) > 0,
+                };
+                assert_same_weights(&path, &rules, &format!("case {case}, {heuristic:?}"));
+            }
+        }
+    }
+
+    #[test]
+    fn partial_products_beyond_f64_keep_their_weights() {
+        // Going from s = 11 down to s = 1 the product of ratios falls to 10⁻³⁵⁰ and climbs
+        // back to 1; its square (power heuristic) to 10⁻⁷⁰⁰.
+        let mut factors = vec![(1.0, 1.0)];
+        factors.extend([(1e35f32, 1e-35f32); 5]);
+        factors.extend([(1e-35, 1e35); 5]);
+        factors.push((1.0, 1.0));
+        let path: Vec<PathDensity> = factors
+            .iter()
+            .enumerate()
+            .map(|(j, &(from_camera, from_light))| PathDensity {
+                from_light,
+                from_camera,
+                connectible: matches!(j, 0 | 1 | 10 | 11),
+            })
+            .collect();
+        for heuristic in [Heuristic::Balance, Heuristic::Power] {
+            let rules = StrategyRules {
+                heuristic,
+                hide_emitters: false,
+                light_hittable: false,
+                light_seen_by_camera: true,
+            };
+            for s in [1, 11] {
+                let w = recursive_weight(&path, s, &rules);
+                assert!((w - 0.5).abs() < 1e-6, "{heuristic:?}, s = {s}: {w}");
+            }
+            assert_same_weights(&path, &rules, &format!("{heuristic:?}"));
+        }
+    }
+}
