@@ -34,6 +34,18 @@ impl BsdfModel for Diffuse {
         }
     }
 
+    fn eval_with_pdfs(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> (Rgb, f32, f32) {
+        if wo.z > 0.0 && wi.z > 0.0 {
+            (
+                self.reflectance * INV_PI,
+                cosine_hemisphere_pdf(wi),
+                cosine_hemisphere_pdf(wo),
+            )
+        } else {
+            (Rgb::BLACK, self.pdf(wo, wi), self.pdf(wi, wo))
+        }
+    }
+
     fn sample(&self, wo: Vec3, _u_lobe: f32, u: Vec2, _mode: TransportMode) -> Option<BsdfSample> {
         if wo.z <= 0.0 {
             return None;

@@ -150,6 +150,12 @@ impl BsdfFlags {
 pub trait BsdfModel {
     fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb;
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+    /// f(wo, wi) with the densities of sampling wi from wo and wo from wi (a path's two
+    /// directions through a connection's endpoint) in one call; models whose evaluation
+    /// and densities share work override it.
+    fn eval_with_pdfs(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> (Rgb, f32, f32) {
+        (self.eval(wo, wi, mode), self.pdf(wo, wi), self.pdf(wi, wo))
+    }
     fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample>;
     fn flags(&self) -> BsdfFlags;
 }
@@ -338,6 +344,12 @@ impl Bsdf {
     /// Solid-angle density of `sample` producing `wi` (non-delta components only).
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         dispatch!(self, m => m.pdf(wo, wi))
+    }
+
+    /// (`eval(wo, wi)`, `pdf(wo, wi)`, `pdf(wi, wo)`) in one call.
+    #[inline]
+    pub fn eval_with_pdfs(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> (Rgb, f32, f32) {
+        dispatch!(self, m => m.eval_with_pdfs(wo, wi, mode))
     }
 
     /// Samples a direction `wi` given `wo` (see the module contract).

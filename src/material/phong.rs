@@ -69,6 +69,28 @@ impl BsdfModel for Phong {
         mixture_pdf(self.specular_weight, lobe, wi)
     }
 
+    /// cosⁿα once for f and both densities: α is symmetric in wo and wi.
+    fn eval_with_pdfs(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> (Rgb, f32, f32) {
+        if wo.z <= 0.0 || wi.z <= 0.0 {
+            return (Rgb::BLACK, 0.0, 0.0);
+        }
+        let c = Self::cos_alpha(wo, wi);
+        let n = self.exponent;
+        let cos_n = if c > 0.0 { c.powf(n) } else { 0.0 };
+        let spec = (n + 2.0) * 0.5 * INV_PI * cos_n;
+        // `cosine_power_pdf` of (0, 0, c), whose cosine is 0 at c = 0.
+        let lobe = if c > 0.0 {
+            (n + 1.0) * 0.5 * INV_PI * cos_n
+        } else {
+            0.0
+        };
+        (
+            diffuse_plus_glossy(self.diffuse_reflectance, self.specular_reflectance, spec),
+            mixture_pdf(self.specular_weight, lobe, wi),
+            mixture_pdf(self.specular_weight, lobe, wo),
+        )
+    }
+
     fn sample(&self, wo: Vec3, u_lobe: f32, u: Vec2, mode: TransportMode) -> Option<BsdfSample> {
         sample_mixture(self, wo, u_lobe, u, mode, self.specular_weight, |u| {
             let local = square_to_cosine_power(u, self.exponent);

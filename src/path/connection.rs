@@ -44,6 +44,18 @@ pub struct Connection<'a> {
     /// The film position, for t = 1 (splatted); None for the camera sample's pixel.
     pub raster: Option<Vec2>,
     pub sampled: Option<Sampled<'a>>,
+    /// The BSDF densities (solid angle) its evaluation gave at the endpoints, for the weight.
+    pub densities: EndpointDensities,
+}
+
+/// The solid-angle densities of the BSDFs at a connection's endpoints, from the same
+/// evaluation as their f (`Bsdf::eval_with_pdfs`): at z(t−1), of leaving towards y(s−1)
+/// having come from z(t−2), and the reverse; at y(s−1), towards z(t−1) from y(s−2), and the
+/// reverse. None where the endpoint is not a surface the connection evaluated.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EndpointDensities {
+    pub camera: Option<(f32, f32)>,
+    pub light: Option<(f32, f32)>,
 }
 
 /// The unweighted contribution of strategy (s, t); None when it gives nothing. Draws a
@@ -75,7 +87,7 @@ pub fn connect<'a>(
             pmf,
             sample: ls,
         } = next_event::sample_light(scene, si_pt.p, sampler)?;
-        let f = bsdf_pt.eval(
+        let (f, pdf_fwd, pdf_rev) = bsdf_pt.eval_with_pdfs(
             frame_pt.to_local(pt.wo),
             frame_pt.to_local(ls.wi),
             TransportMode::Radiance,
@@ -96,6 +108,10 @@ pub fn connect<'a>(
                 vertex,
                 light_side: true,
             }),
+            densities: EndpointDensities {
+                camera: Some((pdf_fwd, pdf_rev)),
+                light: None,
+            },
         });
     }
     let qs = &light_path[s - 1];
@@ -108,12 +124,13 @@ pub fn connect<'a>(
     let w = d / dist2.sqrt();
     // f at the light vertex (importance, with the adjoint's shading-normal factor)
     // and at the camera vertex, and G with shading-normal cosines (Veach 1997, §10.2).
-    let f_qs = bsdf_qs.eval(
+    let (f_qs, light_fwd, light_rev) = bsdf_qs.eval_with_pdfs(
         frame_qs.to_local(qs.wo),
         frame_qs.to_local(w),
         TransportMode::Importance,
-    ) * adjoint_shading_factor(qs.wo, w, si_qs.ns, si_qs.ng);
-    let f_pt = bsdf_pt.eval(
+    );
+    let f_qs = f_qs * adjoint_shading_factor(qs.wo, w, si_qs.ns, si_qs.ng);
+    let (f_pt, camera_fwd, camera_rev) = bsdf_pt.eval_with_pdfs(
         frame_pt.to_local(pt.wo),
         frame_pt.to_local(-w),
         TransportMode::Radiance,
@@ -124,6 +141,10 @@ pub fn connect<'a>(
         shadow: Some(si_qs.spawn_ray_to_interaction(si_pt)),
         raster: None,
         sampled: None,
+        densities: EndpointDensities {
+            camera: Some((camera_fwd, camera_rev)),
+            light: Some((light_fwd, light_rev)),
+        },
     })
 }
 
@@ -152,6 +173,7 @@ fn emitter_found<'a>(
         shadow: None,
         raster: None,
         sampled: None,
+        densities: EndpointDensities::default(),
     })
 }
 
@@ -200,6 +222,7 @@ fn light_vertex_to_camera<'a>(
             vertex: Vertex::camera(splat.camera_position, Vec3::ZERO),
             light_side: false,
         }),
+        densities: EndpointDensities::default(),
     })
 }
 
@@ -250,12 +273,13 @@ fn joint(
     scene: &Scene,
     light_path: &[Vertex],
     camera_path: &[Vertex],
-    sampled: Option<&Sampled>,
+    connection: &Connection,
     s: usize,
     t: usize,
     heuristic: Heuristic,
     hide_emitters: bool,
 ) -> (Joint, StrategyRules) {
+    let sampled = connection.sampled.as_ref();
     // The strategy's endpoints as vertices (the sampled one where there is one).
     let light_end = |i: usize| match sampled {
         Some(Sampled {
@@ -278,12 +302,18 @@ fn joint(
     // Whatever their walks sampled next, the path leaves the connection's endpoints along
     // the connection, through non-delta components: both are connectible. The densities
     // the connection creates: of pt from the light side, of pt_minus from pt; of qs from
-    // the camera side, of qs_minus from qs.
+    // the camera side, of qs_minus from qs (from the BSDF densities the connection
+    // evaluated where it did, converted to the measure of the vertex reached).
+    let EndpointDensities {
+        camera: at_pt,
+        light: at_qs,
+    } = connection.densities;
     let camera = [
         Some(PathDensity {
-            from_light: match qs {
-                Some(qs) => qs.pdf(scene, qs_minus, pt),
-                None => {
+            from_light: match (qs, at_qs) {
+                (Some(qs), Some((fwd, _))) => qs.to_area(fwd, pt),
+                (Some(qs), None) => qs.pdf(scene, qs_minus, pt),
+                (None, _) => {
                     pt.pdf_light_origin(scene, pt.direction_to(pt_minus.expect("s = 0 has t ≥ 2")))
                 }
             },
@@ -291,9 +321,10 @@ fn joint(
             connectible: true,
         }),
         pt_minus.map(|pt_minus| PathDensity {
-            from_light: match qs {
-                Some(qs) => pt.pdf(scene, Some(qs), pt_minus),
-                None => pt.pdf_light_direction(scene, pt_minus),
+            from_light: match (qs, at_pt) {
+                (Some(_), Some((_, rev))) => pt.to_area(rev, pt_minus),
+                (Some(qs), None) => pt.pdf(scene, Some(qs), pt_minus),
+                (None, _) => pt.pdf_light_direction(scene, pt_minus),
             },
             from_camera: pt_minus.pdf_fwd,
             connectible: connectible(pt_minus),
@@ -302,12 +333,18 @@ fn joint(
     let light = [
         qs.map(|qs| PathDensity {
             from_light: qs.pdf_fwd,
-            from_camera: pt.pdf(scene, pt_minus, qs),
+            from_camera: match at_pt {
+                Some((fwd, _)) => pt.to_area(fwd, qs),
+                None => pt.pdf(scene, pt_minus, qs),
+            },
             connectible: true,
         }),
         qs_minus.map(|qs_minus| PathDensity {
             from_light: qs_minus.pdf_fwd,
-            from_camera: qs.expect("s ≥ 2").pdf(scene, Some(pt), qs_minus),
+            from_camera: match at_qs {
+                Some((_, rev)) => qs.expect("s ≥ 2").to_area(rev, qs_minus),
+                None => qs.expect("s ≥ 2").pdf(scene, Some(pt), qs_minus),
+            },
             connectible: s == 2 || connectible(qs_minus),
         }),
     ];
@@ -331,7 +368,7 @@ pub fn weight(
     scene: &Scene,
     light_path: &[Vertex],
     camera_path: &[Vertex],
-    sampled: Option<&Sampled>,
+    connection: &Connection,
     s: usize,
     t: usize,
     heuristic: Heuristic,
@@ -342,7 +379,7 @@ pub fn weight(
         scene,
         light_path,
         camera_path,
-        sampled,
+        connection,
         s,
         t,
         heuristic,

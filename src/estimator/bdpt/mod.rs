@@ -266,7 +266,7 @@ impl BdptSample {
                     scene,
                     light_path,
                     camera_path,
-                    c.sampled.as_ref(),
+                    &c,
                     s,
                     t,
                     settings.mis,

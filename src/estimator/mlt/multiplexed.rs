@@ -187,7 +187,7 @@ impl PathTarget for MultiplexedTarget {
             scene,
             light_path,
             camera_path,
-            c.sampled.as_ref(),
+            &c,
             s,
             t,
             self.mis,
