@@ -20,24 +20,47 @@
 
 use crate::path::mis::{Heuristic, PathDensity, ScaledRatio, StrategyRules};
 
-/// ρ = num / den in f64 (squared for the power heuristic); exactly 0 when num is 0 (every
-/// strategy beyond that vertex is impossible, whatever den), ∞ when only den is.
+/// x^p in f64: the density itself (balance heuristic) or its square (power heuristic).
 #[inline(always)]
-fn ratio(num: f32, den: f32, power: bool) -> f64 {
+fn heuristic_power(x: f32, power: bool) -> f64 {
+    let x = x as f64;
+    if power { x * x } else { x }
+}
+
+/// 1/den^p in f64: ∞ for den = 0.
+#[inline(always)]
+fn reciprocal(den: f32, power: bool) -> f64 {
+    1.0 / heuristic_power(den, power)
+}
+
+/// The ratio num^p / den^p given den's reciprocal: exactly 0 when num is 0 (every strategy
+/// beyond that vertex is impossible, whatever den), ∞ when only den is 0.
+#[inline(always)]
+fn ratio(num: f32, reciprocal_den: f64, power: bool) -> f64 {
     if num == 0.0 {
         return 0.0;
     }
-    let r = num as f64 / den as f64;
-    if power { r * r } else { r }
+    heuristic_power(num, power) * reciprocal_den
 }
 
-/// One subpath's partial sums, one per vertex (see the module comment).
+/// One subpath's partial sums (see the module comment), each already divided by its
+/// vertex's own sampling density (to the heuristic's power), and those densities'
+/// reciprocals: a strategy's weight then needs no division beyond its last.
 #[derive(Clone, Debug, Default)]
 pub struct SubpathSums {
-    sums: Vec<ScaledRatio>,
+    /// G_k / own_k^p (light side), H_m / own_m^p (camera side).
+    over_own: Vec<ScaledRatio>,
+    /// 1 / own_k^p.
+    reciprocal: Vec<f64>,
 }
 
 impl SubpathSums {
+    fn push(&mut self, sum: ScaledRatio, own: f32, power: bool) {
+        let r = reciprocal(own, power);
+        self.over_own.push(sum.scaled(r));
+        self.reciprocal.push(r);
+    }
+
     /// A light subpath x0 x1 … as `mis` sees its vertices (from_light its own sampling
     /// density, from_camera the reverse one, `connectible` the light side's rule), with
     /// x0's strategy s = 0 possible or not (`light_hittable`): G_0 = c_0,
@@ -49,21 +72,19 @@ impl SubpathSums {
         heuristic: Heuristic,
     ) {
         let power = heuristic == Heuristic::Power;
-        self.sums.clear();
-        let mut g = ScaledRatio::ZERO;
+        self.over_own.clear();
+        self.reciprocal.clear();
         let mut previous: Option<PathDensity> = None;
         for v in vertices {
-            let c = match previous {
-                None => light_hittable,
+            let (g, c) = match previous {
+                None => (ScaledRatio::ZERO, light_hittable),
                 Some(p) => {
-                    g = g.scaled(ratio(p.from_camera, p.from_light, power));
-                    p.connectible && v.connectible
+                    let k = self.over_own.len() - 1;
+                    let g = self.over_own[k].scaled(heuristic_power(p.from_camera, power));
+                    (g, p.connectible && v.connectible)
                 }
             };
-            if c {
-                g = g.plus_one();
-            }
-            self.sums.push(g);
+            self.push(if c { g.plus_one() } else { g }, v.from_light, power);
             previous = Some(v);
         }
     }
@@ -77,20 +98,28 @@ impl SubpathSums {
         heuristic: Heuristic,
     ) {
         let power = heuristic == Heuristic::Power;
-        self.sums.clear();
-        let mut h = ScaledRatio::ZERO;
+        self.over_own.clear();
+        self.reciprocal.clear();
         let mut previous: Option<PathDensity> = None;
         for v in vertices {
-            if let Some(p) = previous {
-                // H_0 = 0 is never multiplied: z0's ratio belongs to no strategy.
-                if self.sums.len() >= 2 {
-                    h = h.scaled(ratio(p.from_light, p.from_camera, power));
+            let h = match previous {
+                None => ScaledRatio::ZERO,
+                Some(p) => {
+                    // H_0 = 0 is never multiplied: z0's ratio belongs to no strategy.
+                    let m = self.over_own.len();
+                    let h = if m >= 2 {
+                        self.over_own[m - 1].scaled(heuristic_power(p.from_light, power))
+                    } else {
+                        ScaledRatio::ZERO
+                    };
+                    if p.connectible && v.connectible {
+                        h.plus_one()
+                    } else {
+                        h
+                    }
                 }
-                if p.connectible && v.connectible {
-                    h = h.plus_one();
-                }
-            }
-            self.sums.push(h);
+            };
+            self.push(h, v.from_camera, power);
             previous = Some(v);
         }
     }
@@ -98,7 +127,10 @@ impl SubpathSums {
 
 /// The vertices on both sides of strategy s's joint as the complete path sees them, the
 /// densities the connection created included: x(s−1), x(s−2) on the light side and x(s),
-/// x(s+1) on the camera side (None where the path has no such vertex).
+/// x(s+1) on the camera side (None where the path has no such vertex). Their own sampling
+/// densities (from_light on the light side, from_camera on the camera side) are the
+/// subpaths', and are read from the sums, except x0's for s = 1 (next-event estimation
+/// samples its own light point).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Joint {
     pub light: [Option<PathDensity>; 2],
@@ -106,8 +138,8 @@ pub struct Joint {
 }
 
 /// The weight of strategy (s, t) for its path of s + t vertices, from its joint and the
-/// partial sums of the light subpath (its first s − 2 vertices are read) and of the camera
-/// subpath (its first t − 2): `mis::strategy_weight` of the same path, up to rounding.
+/// partial sums of the light subpath (its first s − 1 vertices are read) and of the camera
+/// subpath (its first t): `mis::strategy_weight` of the same path, up to rounding.
 pub fn joint_weight(
     joint: &Joint,
     light: &SubpathSums,
@@ -129,7 +161,7 @@ pub fn joint_weight(
         (Some(a), s) if s >= 1 => {
             let inner = match x_s2 {
                 Some(b) if s >= 2 => {
-                    light.sums[s - 2].scaled(ratio(b.from_camera, b.from_light, power))
+                    light.over_own[s - 2].scaled(heuristic_power(b.from_camera, power))
                 }
                 _ => ScaledRatio::ZERO,
             };
@@ -138,7 +170,12 @@ pub fn joint_weight(
             } else {
                 inner
             };
-            inner.scaled(ratio(a.from_camera, a.from_light, power))
+            let own = if s >= 2 {
+                light.reciprocal[s - 1]
+            } else {
+                reciprocal(a.from_light, power)
+            };
+            inner.scaled(ratio(a.from_camera, own, power))
         }
         _ => ScaledRatio::ZERO,
     };
@@ -146,7 +183,7 @@ pub fn joint_weight(
     let right = match (x_s, x_sp1) {
         (Some(a), Some(b)) if t >= 2 => {
             let inner = if t >= 3 {
-                camera.sums[t - 2].scaled(ratio(b.from_light, b.from_camera, power))
+                camera.over_own[t - 2].scaled(heuristic_power(b.from_light, power))
             } else {
                 ScaledRatio::ZERO
             };
@@ -155,7 +192,7 @@ pub fn joint_weight(
             } else {
                 inner
             };
-            inner.scaled(ratio(a.from_light, a.from_camera, power))
+            inner.scaled(ratio(a.from_light, camera.reciprocal[t - 1], power))
         }
         _ => ScaledRatio::ZERO,
     };
