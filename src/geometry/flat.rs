@@ -19,8 +19,9 @@
 //! equal t can differ from the tree's (here the lowest record index wins).
 
 use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord};
+use crate::math::lanes::{F32x16, NATIVE, U32x16};
 
-/// Triangles per chunk: one AVX-512 register, or two AVX2 ones.
+/// Triangles per chunk: one `F32x16` (one AVX-512 register, or two AVX2 ones).
 const LANES: usize = 16;
 
 /// Scenes with at most this many triangles (three chunks) are answered by `FlatTriangles`.
@@ -157,273 +158,82 @@ impl LaneTests {
     }
 }
 
-/// Sixteen lanes of f32, for `triangle::t_num_error_bound_in`.
-#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
-mod lanes {
-    use std::arch::x86_64::*;
-
-    #[derive(Clone, Copy)]
-    pub(super) struct Lanes(pub __m512);
-
-    // SAFETY (every intrinsic below): AVX-512F is enabled at compile time (the module's
-    // cfg); register operations only.
-    macro_rules! lane_op {
-        ($op:ident, $method:ident, $intrinsic:ident) => {
-            impl std::ops::$op for Lanes {
-                type Output = Lanes;
-                #[inline(always)]
-                fn $method(self, o: Lanes) -> Lanes {
-                    Lanes(unsafe { $intrinsic(self.0, o.0) })
-                }
-            }
-        };
-    }
-    lane_op!(Add, add, _mm512_add_ps);
-    lane_op!(Mul, mul, _mm512_mul_ps);
-
-    impl super::triangle::BoundArithmetic for Lanes {
-        #[inline(always)]
-        fn splat(v: f32) -> Lanes {
-            Lanes(unsafe { _mm512_set1_ps(v) })
-        }
-    }
-}
-
-/// The watertight test's arithmetic on the sixteen lanes of `c` (see `LaneTests`).
-#[cfg(all(target_arch = "x86_64", target_feature = "avx512f"))]
+/// The watertight test's arithmetic on the sixteen lanes of `c` (see `LaneTests`), in the
+/// lane types (`math::lanes`) where they are vector registers, else the portable loop.
 #[inline(always)]
 fn lane_tests(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
-    use lanes::Lanes;
-    use std::arch::x86_64::*;
-    // SAFETY: AVX-512F is enabled at compile time (cfg above); `Chunk` and `LaneTests` are
-    // 64-byte aligned and each row is 16 floats, so the aligned loads and stores stay
-    // inside them.
-    unsafe {
-        let load = |row: &[f32; LANES]| _mm512_load_ps(row.as_ptr());
-        let splat = _mm512_set1_ps;
-        let (cx, cy, cz) = (&c.v[r.kx], &c.v[r.ky], &c.v[r.kz]);
-        let (ox, oy, oz) = (splat(r.ox), splat(r.oy), splat(r.oz));
-        let (sx, sy, sz) = (splat(r.sx), splat(r.sy), splat(r.sz));
-        // Sheared vertex coordinates, as `triangle::intersect_scalar`.
-        let vertex = |j: usize| {
-            let z = _mm512_sub_ps(load(&cz[j]), oz);
-            let x = _mm512_sub_ps(_mm512_sub_ps(load(&cx[j]), ox), _mm512_mul_ps(sx, z));
-            let y = _mm512_sub_ps(_mm512_sub_ps(load(&cy[j]), oy), _mm512_mul_ps(sy, z));
-            (x, y, z)
-        };
-        let (x0, y0, z0) = vertex(0);
-        let (x1, y1, z1) = vertex(1);
-        let (x2, y2, z2) = vertex(2);
-        let edge = |xa, yb, ya, xb| _mm512_sub_ps(_mm512_mul_ps(xa, yb), _mm512_mul_ps(ya, xb));
-        let e0 = edge(x2, y1, y2, x1);
-        let e1 = edge(x0, y2, y0, x2);
-        let e2 = edge(x1, y0, y1, x0);
-        let zero = _mm512_setzero_ps();
-        let lt = |a, b| _mm512_cmp_ps_mask::<_CMP_LT_OQ>(a, b);
-        let ne = |e| _mm512_cmp_ps_mask::<_CMP_NEQ_UQ>(e, zero);
-        let any_neg = lt(e0, zero) | lt(e1, zero) | lt(e2, zero);
-        let any_pos = lt(zero, e0) | lt(zero, e1) | lt(zero, e2);
-        let all_nonzero = ne(e0) & ne(e1) & ne(e2);
-        let det = _mm512_add_ps(_mm512_add_ps(e0, e1), e2);
-        let t_num = _mm512_add_ps(
-            _mm512_add_ps(
-                _mm512_mul_ps(e0, _mm512_mul_ps(z0, sz)),
-                _mm512_mul_ps(e1, _mm512_mul_ps(z1, sz)),
-            ),
-            _mm512_mul_ps(e2, _mm512_mul_ps(z2, sz)),
-        );
-        // Both made positive by the determinant's sign. For det = ±0 the flip differs
-        // from the portable code's, but such lanes have a zero edge and are kept anyway.
-        let sign = _mm512_set1_epi32(i32::MIN);
-        let det_bits = _mm512_castps_si512(det);
-        let t_num_p = _mm512_castsi512_ps(_mm512_xor_si512(
-            _mm512_castps_si512(t_num),
-            _mm512_and_si512(det_bits, sign),
-        ));
-        let det_p = _mm512_castsi512_ps(_mm512_andnot_si512(sign, det_bits));
-        let in_range = lt(zero, t_num_p) & lt(t_num_p, _mm512_mul_ps(splat(t_max), det_p));
-        let keep = !(any_neg & any_pos) & (!all_nonzero | in_range);
-        let mut out = LaneTests {
-            e: [[0.0; LANES]; 3],
-            t_num: [0.0; LANES],
-            keep: keep as u32,
-            settled: 0,
-        };
-        if keep == 0 {
-            // Most chunks: nothing crosses the segment.
-            return out;
-        }
-        // T's error bound from the largest |x|, |y|, |z| and |e|, as the per-triangle test
-        // computes it (exact maxima: the same values in any order).
-        let abs = |v| _mm512_abs_ps(v);
-        let max3 = |a, b, c| _mm512_max_ps(_mm512_max_ps(abs(a), abs(b)), abs(c));
-        let max_xy = _mm512_max_ps(max3(x0, x1, x2), max3(y0, y1, y2));
-        let bound = triangle::t_num_error_bound_in(
-            Lanes(max_xy),
-            Lanes(max3(z0, z1, z2)),
-            Lanes(max3(e0, e1, e2)),
-            Lanes(splat(r.sz.abs())),
-        )
-        .0;
-        let settled =
-            keep & all_nonzero & in_range & lt(bound, t_num_p) & lt(bound, splat(f32::INFINITY));
-        out.settled = settled as u32;
-        _mm512_store_ps(out.e[0].as_mut_ptr(), e0);
-        _mm512_store_ps(out.e[1].as_mut_ptr(), e1);
-        _mm512_store_ps(out.e[2].as_mut_ptr(), e2);
-        _mm512_store_ps(out.t_num.as_mut_ptr(), t_num);
-        out
+    if NATIVE {
+        lane_tests_in_registers(c, r, t_max)
+    } else {
+        lane_tests_portable(c, r, t_max)
     }
 }
 
-/// Eight lanes of f32 in one AVX2 register, for `triangle::t_num_error_bound_in`.
-#[cfg(all(
-    target_arch = "x86_64",
-    target_feature = "avx2",
-    not(target_feature = "avx512f")
-))]
-mod lanes_avx2 {
-    use std::arch::x86_64::*;
-
-    #[derive(Clone, Copy)]
-    pub(super) struct Lanes(pub __m256);
-
-    // SAFETY (every intrinsic below): AVX2 (and so AVX) is enabled at compile time (the
-    // module's cfg); register operations only.
-    impl std::ops::Add for Lanes {
-        type Output = Lanes;
-        #[inline(always)]
-        fn add(self, o: Lanes) -> Lanes {
-            Lanes(unsafe { _mm256_add_ps(self.0, o.0) })
-        }
-    }
-
-    impl std::ops::Mul for Lanes {
-        type Output = Lanes;
-        #[inline(always)]
-        fn mul(self, o: Lanes) -> Lanes {
-            Lanes(unsafe { _mm256_mul_ps(self.0, o.0) })
-        }
-    }
-
-    impl super::triangle::BoundArithmetic for Lanes {
-        #[inline(always)]
-        fn splat(v: f32) -> Lanes {
-            Lanes(unsafe { _mm256_set1_ps(v) })
-        }
-    }
-}
-
-/// The watertight test's arithmetic on the sixteen lanes of `c` (see `LaneTests`), as two
-/// AVX2 halves of eight: the operations of the AVX-512 version, lane for lane.
-#[cfg(all(
-    target_arch = "x86_64",
-    target_feature = "avx2",
-    not(target_feature = "avx512f")
-))]
+/// `lane_tests` in `F32x16`: the operations of `lane_tests_portable`, lane for lane.
 #[inline(always)]
-fn lane_tests(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
-    use lanes_avx2::Lanes;
-    use std::arch::x86_64::*;
+fn lane_tests_in_registers(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
+    let load = |row: &[f32; LANES]| F32x16::from_array(*row);
+    let splat = F32x16::splat;
+    let (cx, cy, cz) = (&c.v[r.kx], &c.v[r.ky], &c.v[r.kz]);
+    let (ox, oy, oz) = (splat(r.ox), splat(r.oy), splat(r.oz));
+    let (sx, sy, sz) = (splat(r.sx), splat(r.sy), splat(r.sz));
+    // Sheared vertex coordinates, as `triangle::intersect_scalar`.
+    let vertex = |j: usize| {
+        let z = load(&cz[j]) - oz;
+        let x = (load(&cx[j]) - ox) - sx * z;
+        let y = (load(&cy[j]) - oy) - sy * z;
+        (x, y, z)
+    };
+    let (x0, y0, z0) = vertex(0);
+    let (x1, y1, z1) = vertex(1);
+    let (x2, y2, z2) = vertex(2);
+    let e0 = x2 * y1 - y2 * x1;
+    let e1 = x0 * y2 - y0 * x2;
+    let e2 = x1 * y0 - y1 * x0;
+    let zero = splat(0.0);
+    let any_neg = e0.lt(zero) | e1.lt(zero) | e2.lt(zero);
+    let any_pos = zero.lt(e0) | zero.lt(e1) | zero.lt(e2);
+    // NaN counts as non-zero.
+    let all_nonzero = e0.ne(zero) & e1.ne(zero) & e2.ne(zero);
+    let det = (e0 + e1) + e2;
+    let t_num = (e0 * (z0 * sz) + e1 * (z1 * sz)) + e2 * (z2 * sz);
+    // Both made positive by the determinant's sign bit. For det = ±0 the flip differs from
+    // the portable code's, but such lanes have a zero edge and are kept anyway.
+    let sign = U32x16::splat(0x8000_0000);
+    let t_num_p = F32x16::from_bits(t_num.to_bits() ^ (det.to_bits() & sign));
+    let det_p = det.abs();
+    let in_range = zero.lt(t_num_p) & t_num_p.lt(splat(t_max) * det_p);
+    let keep = !(any_neg & any_pos) & (!all_nonzero | in_range);
     let mut out = LaneTests {
         e: [[0.0; LANES]; 3],
         t_num: [0.0; LANES],
-        keep: 0,
+        keep: keep.0 as u32,
         settled: 0,
     };
-    // SAFETY: AVX2 is enabled at compile time (cfg above); `Chunk` and `LaneTests` are
-    // 64-byte aligned and each row is 16 floats, so the aligned loads and stores of lanes
-    // `base..base + 8` (base 0 or 8: 32-byte aligned) stay inside them.
-    unsafe {
-        let splat = _mm256_set1_ps;
-        let (cx, cy, cz) = (&c.v[r.kx], &c.v[r.ky], &c.v[r.kz]);
-        let (ox, oy, oz) = (splat(r.ox), splat(r.oy), splat(r.oz));
-        let (sx, sy, sz) = (splat(r.sx), splat(r.sy), splat(r.sz));
-        let zero = _mm256_setzero_ps();
-        let lt = |a, b| _mm256_cmp_ps::<_CMP_LT_OQ>(a, b);
-        let is_zero = |e| _mm256_cmp_ps::<_CMP_EQ_OQ>(e, zero);
-        let or = |a, b| _mm256_or_ps(a, b);
-        let and = |a, b| _mm256_and_ps(a, b);
-        for base in [0, LANES / 2] {
-            let load = |row: &[f32; LANES]| _mm256_load_ps(row.as_ptr().add(base));
-            // Sheared vertex coordinates, as `triangle::intersect_scalar`.
-            let vertex = |j: usize| {
-                let z = _mm256_sub_ps(load(&cz[j]), oz);
-                let x = _mm256_sub_ps(_mm256_sub_ps(load(&cx[j]), ox), _mm256_mul_ps(sx, z));
-                let y = _mm256_sub_ps(_mm256_sub_ps(load(&cy[j]), oy), _mm256_mul_ps(sy, z));
-                (x, y, z)
-            };
-            let (x0, y0, z0) = vertex(0);
-            let (x1, y1, z1) = vertex(1);
-            let (x2, y2, z2) = vertex(2);
-            let edge = |xa, yb, ya, xb| _mm256_sub_ps(_mm256_mul_ps(xa, yb), _mm256_mul_ps(ya, xb));
-            let e0 = edge(x2, y1, y2, x1);
-            let e1 = edge(x0, y2, y0, x2);
-            let e2 = edge(x1, y0, y1, x0);
-            let any_neg = or(or(lt(e0, zero), lt(e1, zero)), lt(e2, zero));
-            let any_pos = or(or(lt(zero, e0), lt(zero, e1)), lt(zero, e2));
-            // `!all_nonzero`: an edge function is ±0 (NaN counts as non-zero).
-            let any_zero = or(or(is_zero(e0), is_zero(e1)), is_zero(e2));
-            let det = _mm256_add_ps(_mm256_add_ps(e0, e1), e2);
-            let t_num = _mm256_add_ps(
-                _mm256_add_ps(
-                    _mm256_mul_ps(e0, _mm256_mul_ps(z0, sz)),
-                    _mm256_mul_ps(e1, _mm256_mul_ps(z1, sz)),
-                ),
-                _mm256_mul_ps(e2, _mm256_mul_ps(z2, sz)),
-            );
-            // Both made positive by the determinant's sign, as the AVX-512 version.
-            let sign = _mm256_set1_ps(-0.0);
-            let t_num_p = _mm256_xor_ps(t_num, _mm256_and_ps(det, sign));
-            let det_p = _mm256_andnot_ps(sign, det);
-            let in_range = and(
-                lt(zero, t_num_p),
-                lt(t_num_p, _mm256_mul_ps(splat(t_max), det_p)),
-            );
-            let keep = _mm256_andnot_ps(and(any_neg, any_pos), or(any_zero, in_range));
-            let keep_bits = _mm256_movemask_ps(keep) as u32;
-            if keep_bits == 0 {
-                // Most halves: nothing crosses the segment.
-                continue;
-            }
-            // T's error bound from the largest |x|, |y|, |z| and |e|, as the per-triangle
-            // test computes it (exact maxima: the same values in any order).
-            let abs = |v| _mm256_andnot_ps(sign, v);
-            let max3 = |a, b, c| _mm256_max_ps(_mm256_max_ps(abs(a), abs(b)), abs(c));
-            let max_xy = _mm256_max_ps(max3(x0, x1, x2), max3(y0, y1, y2));
-            let bound = triangle::t_num_error_bound_in(
-                Lanes(max_xy),
-                Lanes(max3(z0, z1, z2)),
-                Lanes(max3(e0, e1, e2)),
-                Lanes(splat(r.sz.abs())),
-            )
-            .0;
-            let settled = _mm256_andnot_ps(
-                any_zero,
-                and(
-                    and(keep, in_range),
-                    and(lt(bound, t_num_p), lt(bound, splat(f32::INFINITY))),
-                ),
-            );
-            out.keep |= keep_bits << base;
-            out.settled |= (_mm256_movemask_ps(settled) as u32) << base;
-            _mm256_store_ps(out.e[0].as_mut_ptr().add(base), e0);
-            _mm256_store_ps(out.e[1].as_mut_ptr().add(base), e1);
-            _mm256_store_ps(out.e[2].as_mut_ptr().add(base), e2);
-            _mm256_store_ps(out.t_num.as_mut_ptr().add(base), t_num);
-        }
+    if keep.none() {
+        // Most chunks: nothing crosses the segment.
+        return out;
     }
+    // T's error bound from the largest |x|, |y|, |z| and |e|, as the per-triangle test
+    // computes it (exact maxima: the same values in any order).
+    let max3 = |a: F32x16, b: F32x16, c: F32x16| a.abs().max_gt(b.abs()).max_gt(c.abs());
+    let max_xy = max3(x0, x1, x2).max_gt(max3(y0, y1, y2));
+    let bound = triangle::t_num_error_bound_in(
+        max_xy,
+        max3(z0, z1, z2),
+        max3(e0, e1, e2),
+        splat(r.sz.abs()),
+    );
+    let settled =
+        keep & all_nonzero & in_range & bound.lt(t_num_p) & bound.lt(splat(f32::INFINITY));
+    out.settled = settled.0 as u32;
+    out.e = [e0.to_array(), e1.to_array(), e2.to_array()];
+    out.t_num = t_num.to_array();
     out
 }
 
-/// `lane_tests` in portable code (autovectorised), for targets without AVX2.
-#[cfg_attr(
-    all(
-        target_arch = "x86_64",
-        any(target_feature = "avx512f", target_feature = "avx2")
-    ),
-    allow(dead_code)
-)]
+/// `lane_tests` in portable code, one lane after another: targets without vector lane
+/// types, and the reference the tests hold the registers' version to.
 #[inline(always)]
 fn lane_tests_portable(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
     let (cx, cy, cz) = (&c.v[r.kx], &c.v[r.ky], &c.v[r.kz]);
@@ -479,15 +289,6 @@ fn lane_tests_portable(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
         out.t_num[i] = t_num;
     }
     out
-}
-
-#[cfg(not(all(
-    target_arch = "x86_64",
-    any(target_feature = "avx512f", target_feature = "avx2")
-)))]
-#[inline(always)]
-fn lane_tests(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
-    lane_tests_portable(c, r, t_max)
 }
 
 #[cfg(test)]

@@ -13,7 +13,6 @@
 //! lanes of their mask, at indices clamped into their slice.
 
 use std::arch::x86_64::*;
-use std::fmt;
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Sub};
 
 use super::{Mask8, Mask16};
@@ -819,26 +818,4 @@ impl U64x8 {
     }
 }
 
-impl fmt::Debug for F32x16 {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "F32x16({:?})", self.to_array())
-    }
-}
-
-impl fmt::Debug for U32x16 {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "U32x16({:?})", self.to_array())
-    }
-}
-
-impl fmt::Debug for F64x8 {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "F64x8({:?})", self.to_array())
-    }
-}
-
-impl fmt::Debug for U64x8 {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "U64x8({:?})", self.to_array())
-    }
-}
+debug_as_array!(F32x16, U32x16, F64x8, U64x8);

@@ -14,6 +14,21 @@
 //! `portable` (arrays and loops, everywhere else). The tests check each
 //! operation of both against the scalar one, NaNs, infinities and signed zeros included.
 
+/// `Debug` for register-backed lane types: their lanes as an array (`to_array`).
+#[cfg(all(
+    target_arch = "x86_64",
+    any(target_feature = "avx512f", target_feature = "avx2")
+))]
+macro_rules! debug_as_array {
+    ($($ty:ident),*) => {
+        $(impl std::fmt::Debug for $ty {
+            fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+                write!(f, "{}({:?})", stringify!($ty), self.to_array())
+            }
+        })*
+    };
+}
+
 mod mask;
 pub mod portable;
 mod real;
