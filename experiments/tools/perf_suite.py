@@ -2,7 +2,7 @@
 renderer's common path must be fast at, and `pt` against Mitsuba 3 side by side.
 
     python3 experiments/tools/perf_suite.py [--repeats 3] [--only envmap,water]
-        [--mitsuba /work/venv-mitsuba/bin/python] [--out results/perf]
+        [--mitsuba /work/venv-mitsuba/bin/python] [--out results/perf] [--binary PATH]
 
 Each scene renders with `mltbench render` (2 threads, its own resolution and max_depth), once
 per estimator and repeat; the table gives the median of the summary line's samples per second
@@ -14,6 +14,10 @@ excluded), and the table gives the median ratio of camera paths per second (not 
 scenes of NO_MITSUBA, which Mitsuba 3 cannot load). Writes
 OUT/README.md and OUT/perf.csv. The meshes two scenes need are written on first use
 (experiments/perf/meshes/, not committed: one has 330k triangles).
+
+--binary times another build (e.g. an older commit's, built with `git worktree` and its own
+CARGO_TARGET_DIR) on this checkout's scenes, for before/after tables; the Mitsuba column
+always times this checkout's build (crosscheck_mitsuba.py).
 
 Needs only the standard library (and a built `target/release/mltbench`).
 """
@@ -149,10 +153,10 @@ def ensure_meshes():
 # ---------------------------------------------------------------- runs
 
 
-def render_rate(scene, args, spp, threads, tmp):
+def render_rate(binary, scene, args, spp, threads, tmp):
     """Samples per second from one `mltbench render`, or an error message."""
     out = Path(tmp) / "perf.exr"
-    cmd = [str(BINARY), "render", str(REPO / scene), *args, "--spp", str(spp)]
+    cmd = [str(binary), "render", str(REPO / scene), *args, "--spp", str(spp)]
     cmd += ["--threads", str(threads), "-o", str(out)]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
@@ -192,9 +196,10 @@ def main(argv):
     p.add_argument("--estimators", help="comma-separated estimators (default all)")
     p.add_argument("--mitsuba", metavar="PYTHON", help="a Python with the mitsuba package")
     p.add_argument("--out", type=Path, default=REPO / "results" / "perf")
+    p.add_argument("--binary", type=Path, default=BINARY, help="the mltbench build to time")
     args = p.parse_args(argv)
-    if not BINARY.exists():
-        print(f"error: {BINARY} not found: run `cargo build --release` first", file=sys.stderr)
+    if not args.binary.exists():
+        print(f"error: {args.binary} not found: run `cargo build --release` first", file=sys.stderr)
         return 2
     scenes = SUITE
     if args.only:
@@ -218,7 +223,7 @@ def main(argv):
             for label, est_args, spp in estimators:
                 rates, error = [], None
                 for _ in range(args.repeats):
-                    rate, error = render_rate(scene, est_args, spp, args.threads, tmp)
+                    rate, error = render_rate(args.binary, scene, est_args, spp, args.threads, tmp)
                     if rate is None:
                         break
                     rates.append(rate)
