@@ -12,11 +12,13 @@
 //! for every strategy that uses it. So each subpath keeps, per vertex k, the partial sum
 //! G_k = c_k + ρ_(k−1) G_(k−1) (light side; mirrored on the camera side), computed once
 //! per subpath, and a strategy adds its joint's two factors on each side. The same
-//! recursion underlies the weights of Georgiev et al. 2012 ("Light transport simulation
-//! with vertex connection and merging", §4 and its technical report), here over the path
-//! density records of `mis` rather than subpath-specific quantities, so every rule of
-//! `StrategyRules` carries over unchanged. Sums are kept scaled (`ScaledRatio`) so that
-//! no f64 overflow or underflow of a partial product changes a weight.
+//! recursion underlies the running MIS quantities of Georgiev's technical report
+//! "Implementing Vertex Connection and Merging" (2012) and of van Antwerpen's (2011); here
+//! it runs over the density records of `mis` rather than subpath-specific quantities, so
+//! every rule of `StrategyRules` carries over unchanged. The partial sums are stored
+//! divided by each vertex's own density (`SubpathSums`), so that a strategy's weight needs
+//! one division. Sums are kept scaled (`ScaledRatio`) so that no f64 overflow or underflow
+//! of a partial product changes a weight.
 
 use crate::path::mis::{Heuristic, PathDensity, ScaledRatio, StrategyRules};
 
