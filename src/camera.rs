@@ -96,6 +96,9 @@ pub struct CameraConnection {
     /// thin lens this already divides by the density 1 / (π r²) of the lens point, which
     /// cancels the lens area in We (pbrt-v3 §16.1.1), so the formula is the pinhole's.
     pub importance: f32,
+    /// The solid-angle density of a camera ray from `camera_position` towards the point,
+    /// 1 / (A cos³θ): `pdf_direction_from` without computing the direction again.
+    pub pdf_direction: f32,
 }
 
 /// The horizontal field of view in degrees that Mitsuba 3 derives from `fov` along
@@ -486,6 +489,7 @@ impl Camera {
             direction_to_camera,
             distance,
             importance,
+            pdf_direction: 1.0 / (self.plane_area * cos * cos * cos),
         })
     }
 }

@@ -185,7 +185,7 @@ impl<'a> WalkHook<'a> for CameraJoin<'_, '_> {
         if let VertexKind::Surface { si, bsdf, frame } = &v.kind
             && v.is_connectible()
             && let Some(splat) = camera_connection::connect_surface(
-                self.scene, si, frame, bsdf, v.wo, walk.beta, u_lens,
+                self.scene, si, frame, bsdf, v.wo, walk.beta, u_lens, false,
             )
         {
             self.tracer

@@ -31,6 +31,11 @@ pub struct CameraSplat {
     pub shadow: Ray,
     /// The camera point joined: the pinhole, or the sampled point of the lens.
     pub camera_position: Vec3,
+    /// The solid-angle density of a camera ray from `camera_position` towards the vertex.
+    pub pdf_camera: f32,
+    /// For a surface vertex joined `with_densities`: the BSDF's solid-angle densities of
+    /// leaving towards the camera having arrived from `wo`, and of the reverse.
+    pub bsdf_densities: Option<(f32, f32)>,
 }
 
 /// The adjoint BSDF's shading-normal factor |wo·ns| |wi·ng| / (|wo·ng| |wi·ns|) for a light
@@ -85,14 +90,18 @@ pub fn connect_emitter(
             t_max: 1.0 - SHADOW_EPSILON,
         },
         camera_position: c.camera_position,
+        pdf_camera: c.pdf_direction,
+        bsdf_densities: None,
     })
 }
 
 /// A surface vertex `si` of a light subpath with throughput `beta`, reached from world
 /// direction `wo` (pointing back along the subpath), with BSDF `bsdf` in shading frame
 /// `frame`. None when the point lies outside the image or the BSDF sends nothing to the
-/// camera (delta components never do).
+/// camera (delta components never do). `with_densities` also evaluates the BSDF's densities
+/// (for a bidirectional estimator's weight; light tracing needs none).
 #[allow(clippy::too_many_arguments)]
+#[inline]
 pub fn connect_surface(
     scene: &Scene,
     si: &SurfaceInteraction,
@@ -101,14 +110,20 @@ pub fn connect_surface(
     wo: Vec3,
     beta: Rgb,
     u_lens: Vec2,
+    with_densities: bool,
 ) -> Option<CameraSplat> {
     let c = scene.camera.connect_lens(si.p, u_lens)?;
     let wi = c.direction_to_camera;
-    let f = bsdf.eval(
-        frame.to_local(wo),
-        frame.to_local(wi),
-        TransportMode::Importance,
-    );
+    let (wo_local, wi_local) = (frame.to_local(wo), frame.to_local(wi));
+    let (f, bsdf_densities) = if with_densities {
+        let (f, fwd, rev) = bsdf.eval_with_pdfs(wo_local, wi_local, TransportMode::Importance);
+        (f, Some((fwd, rev)))
+    } else {
+        (
+            bsdf.eval(wo_local, wi_local, TransportMode::Importance),
+            None,
+        )
+    };
     // f · |cos θ| at the surface, with the adjoint's shading-normal factor:
     // f · |wi·ns| · |wo·ns||wi·ng| / (|wo·ng||wi·ns|) = f · |wo·ns| |wi·ng| / |wo·ng|.
     let cos = adjoint_shading_factor(wo, wi, si.ns, si.ng) * wi.dot(si.ns).abs();
@@ -121,5 +136,7 @@ pub fn connect_surface(
         value,
         shadow: si.spawn_ray_to(c.camera_position),
         camera_position: c.camera_position,
+        pdf_camera: c.pdf_direction,
+        bsdf_densities,
     })
 }

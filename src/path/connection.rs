@@ -51,7 +51,8 @@ pub struct Connection<'a> {
 /// The solid-angle densities of the BSDFs at a connection's endpoints, from the same
 /// evaluation as their f (`Bsdf::eval_with_pdfs`): at z(t−1), of leaving towards y(s−1)
 /// having come from z(t−2), and the reverse; at y(s−1), towards z(t−1) from y(s−2), and the
-/// reverse. None where the endpoint is not a surface the connection evaluated.
+/// reverse. For t = 1 the camera's is the density of its ray towards y(s−1) (no reverse).
+/// None where the connection did not evaluate the endpoint.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct EndpointDensities {
     pub camera: Option<(f32, f32)>,
@@ -209,9 +210,9 @@ fn light_vertex_to_camera<'a>(
                 u_lens,
             )?
         }
-        VertexKind::Surface { si, bsdf, frame } => {
-            camera_connection::connect_surface(scene, si, frame, bsdf, qs.wo, qs.beta, u_lens)?
-        }
+        VertexKind::Surface { si, bsdf, frame } => camera_connection::connect_surface(
+            scene, si, frame, bsdf, qs.wo, qs.beta, u_lens, true,
+        )?,
         VertexKind::Infinite { .. } | VertexKind::Camera => return None,
     };
     Some(Connection {
@@ -222,7 +223,11 @@ fn light_vertex_to_camera<'a>(
             vertex: Vertex::camera(splat.camera_position, Vec3::ZERO),
             light_side: false,
         }),
-        densities: EndpointDensities::default(),
+        // At the camera only the direction's density (no z(t−2) for t = 1).
+        densities: EndpointDensities {
+            camera: Some((splat.pdf_camera, 0.0)),
+            light: splat.bsdf_densities,
+        },
     })
 }
 
