@@ -19,7 +19,7 @@
 //! equal t can differ from the tree's (here the lowest record index wins).
 
 use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord};
-use crate::math::lanes::{F32x16, NATIVE, U32x16};
+use crate::math::lanes::{F32x16, NATIVE, Real, U32x16};
 
 /// Triangles per chunk: one `F32x16` (one AVX-512 register, or two AVX2 ones).
 const LANES: usize = 16;
@@ -169,27 +169,40 @@ fn lane_tests(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
     }
 }
 
+/// A chunk's vertices sheared into the ray's frame and its edge functions, as
+/// `triangle::intersect_scalar` computes them: `[x, y, z]` per vertex, then `e`.
+struct Sheared<T> {
+    v: [[T; 3]; 3],
+    e: [T; 3],
+}
+
+/// `Sheared` for ray `r`, each coordinate read by `load(row of one axis and vertex)`: all
+/// sixteen lanes in `F32x16`, or one lane in `f32`.
+#[inline(always)]
+fn shear<T: Real>(c: &Chunk, r: &TriangleRay, load: impl Fn(&[f32; LANES]) -> T) -> Sheared<T> {
+    let (cx, cy, cz) = (&c.v[r.kx], &c.v[r.ky], &c.v[r.kz]);
+    let splat = T::splat;
+    let vertex = |j: usize| {
+        let z = load(&cz[j]) - splat(r.oz);
+        let x = (load(&cx[j]) - splat(r.ox)) - splat(r.sx) * z;
+        let y = (load(&cy[j]) - splat(r.oy)) - splat(r.sy) * z;
+        [x, y, z]
+    };
+    let v = [vertex(0), vertex(1), vertex(2)];
+    let [[x0, y0, _], [x1, y1, _], [x2, y2, _]] = v;
+    let e = [x2 * y1 - y2 * x1, x0 * y2 - y0 * x2, x1 * y0 - y1 * x0];
+    Sheared { v, e }
+}
+
 /// `lane_tests` in `F32x16`: the operations of `lane_tests_portable`, lane for lane.
 #[inline(always)]
 fn lane_tests_in_registers(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
-    let load = |row: &[f32; LANES]| F32x16::from_array(*row);
     let splat = F32x16::splat;
-    let (cx, cy, cz) = (&c.v[r.kx], &c.v[r.ky], &c.v[r.kz]);
-    let (ox, oy, oz) = (splat(r.ox), splat(r.oy), splat(r.oz));
-    let (sx, sy, sz) = (splat(r.sx), splat(r.sy), splat(r.sz));
-    // Sheared vertex coordinates, as `triangle::intersect_scalar`.
-    let vertex = |j: usize| {
-        let z = load(&cz[j]) - oz;
-        let x = (load(&cx[j]) - ox) - sx * z;
-        let y = (load(&cy[j]) - oy) - sy * z;
-        (x, y, z)
-    };
-    let (x0, y0, z0) = vertex(0);
-    let (x1, y1, z1) = vertex(1);
-    let (x2, y2, z2) = vertex(2);
-    let e0 = x2 * y1 - y2 * x1;
-    let e1 = x0 * y2 - y0 * x2;
-    let e2 = x1 * y0 - y1 * x0;
+    let sz = splat(r.sz);
+    let Sheared {
+        v: [[x0, y0, z0], [x1, y1, z1], [x2, y2, z2]],
+        e: [e0, e1, e2],
+    } = shear(c, r, |row| F32x16::from_array(*row));
     let zero = splat(0.0);
     let any_neg = e0.lt(zero) | e1.lt(zero) | e2.lt(zero);
     let any_pos = zero.lt(e0) | zero.lt(e1) | zero.lt(e2);
@@ -236,7 +249,6 @@ fn lane_tests_in_registers(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests 
 /// types, and the reference the tests hold the registers' version to.
 #[inline(always)]
 fn lane_tests_portable(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
-    let (cx, cy, cz) = (&c.v[r.kx], &c.v[r.ky], &c.v[r.kz]);
     let mut out = LaneTests {
         e: [[0.0; LANES]; 3],
         t_num: [0.0; LANES],
@@ -244,19 +256,10 @@ fn lane_tests_portable(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
         settled: 0,
     };
     for i in 0..LANES {
-        // Sheared vertex coordinates, as `triangle::intersect_scalar`.
-        let vertex = |j: usize| {
-            let z = cz[j][i] - r.oz;
-            let x = (cx[j][i] - r.ox) - r.sx * z;
-            let y = (cy[j][i] - r.oy) - r.sy * z;
-            (x, y, z)
-        };
-        let (x0, y0, z0) = vertex(0);
-        let (x1, y1, z1) = vertex(1);
-        let (x2, y2, z2) = vertex(2);
-        let e0 = x2 * y1 - y2 * x1;
-        let e1 = x0 * y2 - y0 * x2;
-        let e2 = x1 * y0 - y1 * x0;
+        let Sheared {
+            v: [[x0, y0, z0], [x1, y1, z1], [x2, y2, z2]],
+            e: [e0, e1, e2],
+        } = shear(c, r, |row| row[i]);
         let any_neg = (e0 < 0.0) | (e1 < 0.0) | (e2 < 0.0);
         let any_pos = (e0 > 0.0) | (e1 > 0.0) | (e2 > 0.0);
         let all_nonzero = (e0 != 0.0) & (e1 != 0.0) & (e2 != 0.0);
