@@ -262,7 +262,7 @@ impl ScaledRatio {
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
 
     #[test]
@@ -301,22 +301,29 @@ mod tests {
             .collect()
     }
 
-    #[test]
-    fn a_ratio_far_below_f64_on_the_way_does_not_lose_a_strategy_of_equal_density() {
-        // Going from s = 11 down to s = 1 the ratio falls to 10⁻³⁵⁰ (below f64) and climbs
-        // back to 1: both strategies have the same density, weight ½ each.
+    /// A path on which going from s = 11 down to s = 1 the ratio falls to 10⁻³⁵⁰ (below
+    /// f64) and climbs back to 1: strategies 1 and 11, the only ones that can make it, have
+    /// the same density, weight ½ each. With its rules for `heuristic`.
+    pub(in crate::path) fn path_far_below_f64(
+        heuristic: Heuristic,
+    ) -> (Vec<PathDensity>, StrategyRules) {
         let mut factors = vec![(1.0, 1.0)];
         factors.extend([(1e35, 1e-35); 5]);
         factors.extend([(1e-35, 1e35); 5]);
         factors.push((1.0, 1.0));
-        let path = path_with_ratios(&factors);
+        let rules = StrategyRules {
+            heuristic,
+            hide_emitters: false,
+            light_hittable: false,
+            light_seen_by_camera: true,
+        };
+        (path_with_ratios(&factors), rules)
+    }
+
+    #[test]
+    fn a_ratio_far_below_f64_on_the_way_does_not_lose_a_strategy_of_equal_density() {
         for heuristic in [Heuristic::Balance, Heuristic::Power] {
-            let rules = StrategyRules {
-                heuristic,
-                hide_emitters: false,
-                light_hittable: false,
-                light_seen_by_camera: true,
-            };
+            let (path, rules) = path_far_below_f64(heuristic);
             for s in [1, 11] {
                 let w = strategy_weight(&path, s, &rules);
                 assert!((w - 0.5).abs() < 1e-6, "{heuristic:?}, s = {s}: {w}");

@@ -73,55 +73,65 @@ impl SubpathSums {
         light_hittable: bool,
         heuristic: Heuristic,
     ) {
-        let power = heuristic == Heuristic::Power;
-        self.over_own.clear();
-        self.reciprocal.clear();
-        let mut previous: Option<PathDensity> = None;
-        for v in vertices {
-            let (g, c) = match previous {
-                None => (ScaledRatio::ZERO, light_hittable),
-                Some(p) => {
-                    let k = self.over_own.len() - 1;
-                    let g = self.over_own[k].scaled(heuristic_power(p.from_camera, power));
-                    (g, p.connectible && v.connectible)
-                }
-            };
-            self.push(if c { g.plus_one() } else { g }, v.from_light, power);
-            previous = Some(v);
-        }
+        self.fill(
+            vertices,
+            light_hittable,
+            1,
+            |v| (v.from_light, v.from_camera),
+            heuristic,
+        );
     }
 
     /// A camera subpath z0 z1 … (z0 the camera; from_camera its own sampling density,
     /// from_light the reverse one): H_0 = 0, H_1 = c'_1, H_m = c'_m + σ_(m−1) H_(m−1), c'_m
-    /// the indicator of the strategy with m camera vertices.
+    /// the indicator of the strategy with m camera vertices. H_0 = 0 is never multiplied:
+    /// z0's ratio belongs to no strategy.
     pub fn fill_camera(
         &mut self,
         vertices: impl Iterator<Item = PathDensity>,
+        heuristic: Heuristic,
+    ) {
+        self.fill(
+            vertices,
+            false,
+            2,
+            |v| (v.from_camera, v.from_light),
+            heuristic,
+        );
+    }
+
+    /// S_0 = [first], S_k = [vertices k−1 and k connectible] + ratio_(k−1) S_(k−1), the
+    /// ratio read from `k ≥ multiplied_from` on; `own_and_reverse` gives a vertex's own
+    /// sampling density and the other direction's.
+    fn fill(
+        &mut self,
+        vertices: impl Iterator<Item = PathDensity>,
+        first: bool,
+        multiplied_from: usize,
+        own_and_reverse: impl Fn(&PathDensity) -> (f32, f32),
         heuristic: Heuristic,
     ) {
         let power = heuristic == Heuristic::Power;
         self.over_own.clear();
         self.reciprocal.clear();
         let mut previous: Option<PathDensity> = None;
-        for v in vertices {
-            let h = match previous {
-                None => ScaledRatio::ZERO,
+        for (k, v) in vertices.enumerate() {
+            let (sum, c) = match previous {
+                None => (ScaledRatio::ZERO, first),
                 Some(p) => {
-                    // H_0 = 0 is never multiplied: z0's ratio belongs to no strategy.
-                    let m = self.over_own.len();
-                    let h = if m >= 2 {
-                        self.over_own[m - 1].scaled(heuristic_power(p.from_light, power))
+                    let sum = if k >= multiplied_from {
+                        self.over_own[k - 1].scaled(heuristic_power(own_and_reverse(&p).1, power))
                     } else {
                         ScaledRatio::ZERO
                     };
-                    if p.connectible && v.connectible {
-                        h.plus_one()
-                    } else {
-                        h
-                    }
+                    (sum, p.connectible && v.connectible)
                 }
             };
-            self.push(h, v.from_camera, power);
+            self.push(
+                if c { sum.plus_one() } else { sum },
+                own_and_reverse(&v).0,
+                power,
+            );
             previous = Some(v);
         }
     }
@@ -206,6 +216,7 @@ pub fn joint_weight(
 mod tests {
     use super::*;
     use crate::path::mis::strategy_weight;
+    use crate::path::mis::tests::path_far_below_f64;
     use rand::{RngExt, SeedableRng};
     use rand_xoshiro::Xoshiro256PlusPlus;
 
@@ -274,28 +285,10 @@ mod tests {
 
     #[test]
     fn partial_products_beyond_f64_keep_their_weights() {
-        // Going from s = 11 down to s = 1 the product of ratios falls to 10⁻³⁵⁰ and climbs
-        // back to 1; its square (power heuristic) to 10⁻⁷⁰⁰.
-        let mut factors = vec![(1.0, 1.0)];
-        factors.extend([(1e35f32, 1e-35f32); 5]);
-        factors.extend([(1e-35, 1e35); 5]);
-        factors.push((1.0, 1.0));
-        let path: Vec<PathDensity> = factors
-            .iter()
-            .enumerate()
-            .map(|(j, &(from_camera, from_light))| PathDensity {
-                from_light,
-                from_camera,
-                connectible: matches!(j, 0 | 1 | 10 | 11),
-            })
-            .collect();
+        // The partial products fall to 10⁻³⁵⁰ and climb back to 1; their squares (power
+        // heuristic) to 10⁻⁷⁰⁰.
         for heuristic in [Heuristic::Balance, Heuristic::Power] {
-            let rules = StrategyRules {
-                heuristic,
-                hide_emitters: false,
-                light_hittable: false,
-                light_seen_by_camera: true,
-            };
+            let (path, rules) = path_far_below_f64(heuristic);
             for s in [1, 11] {
                 let w = recursive_weight(&path, s, &rules);
                 assert!((w - 0.5).abs() < 1e-6, "{heuristic:?}, s = {s}: {w}");
