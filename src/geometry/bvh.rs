@@ -151,10 +151,10 @@ pub struct TriangleBvh {
     uvs: Option<Vec<[Vec2; 3]>>,
     depth: usize,
     bounds: (Vec3, Vec3),
-    /// The records laid out for `flat.rs`, which answers the queries instead of the tree
-    /// when there are at most `FLAT_LIMIT` triangles (`nodes` is then empty; otherwise
-    /// this is).
-    flat: FlatTriangles,
+    /// The records laid out sixteen to a chunk (`flat.rs`). Up to `FLAT_LIMIT` triangles
+    /// the queries test them all instead of walking a tree (`nodes` is then empty);
+    /// otherwise the tree's traversal tests each node's hit leaf triangles in these lanes.
+    lanes: FlatTriangles,
     /// The same records for sixteen rays at a time (`packet.rs`), also only when flat.
     packet: PacketTriangles,
 }
@@ -217,16 +217,18 @@ impl TriangleBvh {
         });
         // A flat scene keeps no nodes: `is_flat` is the emptiness test the tree's queries make
         // anyway.
-        let (nodes, flat, packet) = if records.len() <= flat_limit {
+        let (nodes, packet) = if records.len() <= flat_limit {
             let packet = PacketTriangles::new(&records, normals.as_deref());
-            (Vec::new(), FlatTriangles::new(&records), packet)
+            (Vec::new(), packet)
         } else {
-            let nodes = collect_large(wide.nodes.par_iter().copied());
-            (nodes, FlatTriangles::default(), PacketTriangles::default())
+            (
+                collect_large(wide.nodes.par_iter().copied()),
+                PacketTriangles::default(),
+            )
         };
         TriangleBvh {
             nodes,
-            flat,
+            lanes: FlatTriangles::new(&records),
             packet,
             records,
             normals,
@@ -313,7 +315,7 @@ impl TriangleBvh {
             "closest_in for the other kind of scene"
         );
         if FLAT {
-            return self.flat.closest(&self.records, &ray.tri, t_max);
+            return self.lanes.closest(&self.records, &ray.tri, t_max);
         }
         let mut visitor = Closest {
             bvh: self,
@@ -329,7 +331,7 @@ impl TriangleBvh {
     pub fn any_in<const FLAT: bool>(&self, ray: &TraversalRay, t_max: f32) -> bool {
         debug_assert_eq!(FLAT, self.is_flat(), "any_in for the other kind of scene");
         if FLAT {
-            return self.flat.any(&self.records, &ray.tri, t_max);
+            return self.lanes.any(&self.records, &ray.tri, t_max);
         }
         self.traverse_from_root(ray, t_max, &mut Any { bvh: self, ray })
     }
@@ -358,8 +360,8 @@ impl TriangleBvh {
 
     /// Walks the BVH front to back (Ylitie et al. 2017, Algorithm 1: node groups hold the
     /// unvisited hit children of a node as a bit mask ordered by the ray octant; triangle
-    /// groups the hit leaf triangles). `visit` tests one triangle, may lower `t_max`, and
-    /// returns true to stop. Returns true when stopped.
+    /// groups the hit leaf triangles). `visit` tests a node's hit leaf triangles together,
+    /// may lower `t_max`, and returns true to stop. Returns true when stopped.
     #[inline(always)]
     fn traverse<S: TraversalStack>(
         &self,
@@ -393,10 +395,9 @@ impl TriangleBvh {
             } else {
                 node_group = UVec2::ZERO;
             }
-            while tri_group.y != 0 {
-                let bit = tri_group.y.trailing_zeros();
-                tri_group.y &= tri_group.y - 1;
-                if visitor.visit(tri_group.x + bit, t_max) {
+            if tri_group.y != 0 {
+                let bits = std::mem::take(&mut tri_group.y);
+                if visitor.visit(tri_group.x, bits, t_max) {
                     return true;
                 }
             }
@@ -448,10 +449,11 @@ impl TriangleBvh {
     }
 }
 
-/// What traversal does with each triangle of a hit leaf.
+/// What traversal does with the hit leaf triangles of a node.
 trait Visitor {
-    /// Tests record `id`, may lower `t_max`; true stops the traversal.
-    fn visit(&mut self, id: u32, t_max: &mut f32) -> bool;
+    /// Tests records `base + b` for the bits b of `bits` (in that order, sixteen at a time:
+    /// `FlatTriangles::hits_of`), may lower `t_max`; true stops the traversal.
+    fn visit(&mut self, base: u32, bits: u32, t_max: &mut f32) -> bool;
 }
 
 /// Closest hit: keep the nearest, shrink the segment to it.
@@ -463,21 +465,28 @@ struct Closest<'a> {
 
 impl Visitor for Closest<'_> {
     #[inline(always)]
-    fn visit(&mut self, id: u32, t_max: &mut f32) -> bool {
-        if let Some(h) = triangle::intersect(&self.bvh.records[id as usize], &self.ray.tri, *t_max)
-        {
-            *t_max = h.t;
-            self.best = Some((id, h));
-            // The surface data of the closest hit will be read from these: start fetching
-            // them while traversal goes on.
-            if let Some(n) = &self.bvh.normals {
-                prefetch(&n[id as usize]);
-            }
-            if let Some(uv) = &self.bvh.uvs {
-                prefetch(&uv[id as usize]);
-            }
-        }
-        false
+    fn visit(&mut self, base: u32, bits: u32, t_max: &mut f32) -> bool {
+        let (bvh, best) = (self.bvh, &mut self.best);
+        bvh.lanes.hits_of(
+            &bvh.records,
+            &self.ray.tri,
+            base,
+            bits,
+            t_max,
+            |id, h, t_max| {
+                *t_max = h.t;
+                *best = Some((id as u32, h));
+                // The surface data of the closest hit will be read from these: start
+                // fetching them while traversal goes on.
+                if let Some(n) = &bvh.normals {
+                    prefetch(&n[id]);
+                }
+                if let Some(uv) = &bvh.uvs {
+                    prefetch(&uv[id]);
+                }
+                false
+            },
+        )
     }
 }
 
@@ -489,8 +498,12 @@ struct Any<'a> {
 
 impl Visitor for Any<'_> {
     #[inline(always)]
-    fn visit(&mut self, id: u32, t_max: &mut f32) -> bool {
-        triangle::intersect(&self.bvh.records[id as usize], &self.ray.tri, *t_max).is_some()
+    fn visit(&mut self, base: u32, bits: u32, t_max: &mut f32) -> bool {
+        let bvh = self.bvh;
+        bvh.lanes
+            .hits_of(&bvh.records, &self.ray.tri, base, bits, t_max, |_, _, _| {
+                true
+            })
     }
 }
 
@@ -533,7 +546,7 @@ impl Default for TriangleBvh {
             uvs: None,
             depth: 0,
             bounds: (Vec3::INFINITY, Vec3::NEG_INFINITY),
-            flat: FlatTriangles::default(),
+            lanes: FlatTriangles::default(),
             packet: PacketTriangles::default(),
         }
     }
