@@ -32,7 +32,7 @@ use super::cwbvh;
 use super::flat::{FLAT_LIMIT, FlatTriangles};
 use super::offset::gamma;
 use super::packet::PacketTriangles;
-use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord};
+use super::triangle::{TriangleHit, TriangleRay, TriangleRecord};
 
 /// Binary BVH settings for `n` triangles: obvhs's `fast_build` preset (PLOC with a short
 /// search radius and a little reinsertion), with the shortest radius (1, obvhs's fast path)
