@@ -11,7 +11,8 @@
 //! to a few hundred triangles: where the two cross sets `flat::FLAT_LIMIT`.
 //!
 //! `rays/cornell_box/*` times `Geometry`'s queries on the Cornell box alone (one thread,
-//! incoherent rays), to compare with `experiments/tools/mitsuba_ray_rate.py`.
+//! incoherent rays), to compare with `experiments/tools/mitsuba_ray_rate.py`;
+//! `RAYS_SCENE=scene.xml cargo bench --bench rays -- rays/scene` runs them on any scene.
 //!
 //! `cargo bench --bench rays` (criterion prints rays/s as "elem/s"). Figures depend on the
 //! CPU features the build targets (`.cargo/config.toml`: target-cpu=native); state them
@@ -268,9 +269,18 @@ fn bench_flat_crossover(c: &mut Criterion) {
 
 /// The Cornell box alone (36 triangles, answered without the tree) through `Geometry`'s
 /// queries, one thread: the figures to set beside another renderer's ray casting on the
-/// same scene (`experiments/tools/mitsuba_ray_rate.py` casts the same kind of rays).
+/// same scene (`experiments/tools/mitsuba_ray_rate.py` casts the same kind of rays). With
+/// `RAYS_SCENE=path/to/scene.xml` in the environment, the same queries on that scene's
+/// geometry instead (group `rays/scene`).
 fn bench_cornell_queries(c: &mut Criterion) {
-    let geometry = Geometry::build(&cornell_box(556.0));
+    let (name, geometry) = match std::env::var_os("RAYS_SCENE") {
+        Some(path) => {
+            let scene = mltbench::scene::Scene::load(std::path::Path::new(&path))
+                .unwrap_or_else(|e| panic!("RAYS_SCENE={}: {e}", path.to_string_lossy()));
+            ("scene", scene.geometry)
+        }
+        None => ("cornell_box", Geometry::build(&cornell_box(556.0))),
+    };
     let rays = incoherent_rays(&geometry, 1 << 18, 11);
     // Segments ending halfway to the closest hit (rays that escape stay unbounded).
     let shadow: Vec<Ray> = rays
@@ -280,7 +290,7 @@ fn bench_cornell_queries(c: &mut Criterion) {
             Ray { t_max, ..*r }
         })
         .collect();
-    let mut group = c.benchmark_group("rays/cornell_box");
+    let mut group = c.benchmark_group(format!("rays/{name}"));
     group
         .measurement_time(Duration::from_secs(3))
         .throughput(Throughput::Elements(rays.len() as u64));
