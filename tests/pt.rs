@@ -680,7 +680,8 @@ fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
         )),
         vec![],
     ));
-    // 6 cubes (72 triangles): more than a small scene, cast through the tree.
+    // 6 cubes (72 triangles): more than a small scene, cast through the tree; a glass
+    // sphere and a diffuse disk among them (analytic hits beside the tree's triangles).
     let cubes: String = (0..6)
         .map(|i| {
             format!(
@@ -700,6 +701,12 @@ fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
                 {enclosure}
                 {CBOX_LIGHT_RECTANGLE}<emitter type="area"><rgb name="radiance" value="5"/></emitter></shape>
                 {cubes}
+                <shape type="sphere"><point name="center" x="0.3" y="-0.2" z="-2.4"/>
+                    <float name="radius" value="0.25"/>
+                    <bsdf type="dielectric"><float name="int_ior" value="1.5"/></bsdf></shape>
+                <shape type="disk"><transform name="to_world"><scale value="0.3"/>
+                    <rotate y="1" angle="20"/><translate x="-0.4" y="0.1" z="-2.8"/></transform>
+                    <bsdf type="diffuse"><rgb name="reflectance" value="0.3, 0.6, 0.2"/></bsdf></shape>
             </scene>"#,
             camera = camera(),
             enclosure = enclosure("cube", "0.6", "0.1"),

@@ -218,7 +218,7 @@ impl TriangleBvh {
         // A flat scene keeps no nodes: `is_flat` is the emptiness test the tree's queries make
         // anyway.
         let (nodes, packet) = if records.len() <= flat_limit {
-            let packet = PacketTriangles::new(&records, normals.as_deref());
+            let packet = PacketTriangles::new(&records);
             (Vec::new(), packet)
         } else {
             (
@@ -250,6 +250,22 @@ impl TriangleBvh {
     /// All records, in the order the queries number them.
     pub fn records(&self) -> &[TriangleRecord] {
         &self.records
+    }
+
+    /// The records' coordinates, twelve per record (`TriangleRecord::rows`), for gathers.
+    pub fn record_coordinates(&self) -> &[f32] {
+        const _: () = assert!(std::mem::size_of::<TriangleRecord>() == 12 * 4);
+        // SAFETY: a record is exactly its twelve f32s (repr(C), no padding: asserted above).
+        unsafe { std::slice::from_raw_parts(self.records.as_ptr().cast(), 12 * self.records.len()) }
+    }
+
+    /// The vertex normals' coordinates, nine per record (n0.x, n0.y, …, n2.z; zero where
+    /// the mesh has none), for gathers; None when no mesh has normals.
+    pub fn normal_coordinates(&self) -> Option<&[f32]> {
+        const _: () = assert!(std::mem::size_of::<[Vec3; 3]>() == 9 * 4);
+        let n = self.normals.as_ref()?;
+        // SAFETY: `[Vec3; 3]` is nine f32s (glam's Vec3 is repr(C) x, y, z: asserted above).
+        Some(unsafe { std::slice::from_raw_parts(n.as_ptr().cast(), 9 * n.len()) })
     }
 
     /// The records laid out for sixteen rays at a time; empty unless `is_flat`.

@@ -424,14 +424,20 @@ impl Geometry {
     #[inline(always)]
     fn closest_hit_in<const FLAT: bool>(&self, ray: &Ray) -> Option<ClosestHit> {
         let r = ScaledRay::new(ray)?;
-        let (mut hit, t_max) = self.closest_analytic(&r);
-        if let Some((record, h)) = self
+        Some(self.found(self.closest_scaled::<FLAT>(&r)?, r))
+    }
+
+    /// The closest hit along `r`, in `r`'s units (what `found` turns into a `ClosestHit`).
+    #[inline(always)]
+    fn closest_scaled<const FLAT: bool>(&self, r: &ScaledRay) -> Option<Hit> {
+        let (hit, t_max) = self.closest_analytic(r);
+        match self
             .bvh
             .closest_in::<FLAT>(&TraversalRay::new(r.o, r.d), t_max)
         {
-            hit = Some(Hit::Triangle { record, hit: h });
+            Some((record, h)) => Some(Hit::Triangle { record, hit: h }),
+            None => hit,
         }
-        Some(self.found(hit?, r))
     }
 
     /// The `ClosestHit` of traversal result `hit` along `r`: its distance in the query ray's

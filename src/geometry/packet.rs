@@ -66,13 +66,10 @@ pub struct PacketTriangles {
     triangles: Vec<PacketTriangle>,
     /// With `BY_VERTEX`, per record: vertex j's coordinates in lanes 0–2 of vector j.
     by_vertex: Vec<[PacketTriangle; 3]>,
-    /// Per record, the three vertex normals' coordinates (n0.x, n0.y, …, n2.z; zero for a
-    /// mesh without normals), when some mesh has them.
-    normals: Option<Vec<f32>>,
 }
 
 impl PacketTriangles {
-    pub fn new(records: &[TriangleRecord], normals: Option<&[[glam::Vec3; 3]]>) -> PacketTriangles {
+    pub fn new(records: &[TriangleRecord]) -> PacketTriangles {
         let triangles = records
             .iter()
             .map(|r| {
@@ -99,15 +96,9 @@ impl PacketTriangles {
         } else {
             Vec::new()
         };
-        let normals = normals.map(|n| {
-            n.iter()
-                .flat_map(|tri| tri.iter().flat_map(|v| v.to_array()))
-                .collect()
-        });
         PacketTriangles {
             triangles,
             by_vertex,
-            normals,
         }
     }
 }
@@ -515,14 +506,11 @@ impl PacketTriangles {
 pub struct ClosestLanes {
     /// Lanes whose ray hit something.
     pub hit: Mask16,
-    /// True when the sixteen-ray test found them (`best`), false when the per-ray query
-    /// did (`one_by_one`).
-    packet: bool,
+    /// The lanes whose closest hit is a triangle (`best.hit`), and that hit.
     best: BestLanes,
-    /// With `packet`: each lane's closest sphere or disk hit (taken where no triangle is
-    /// closer, `best.hit` unset).
+    /// Each lane's closest sphere or disk hit (taken where no triangle is closer,
+    /// `best.hit` unset).
     analytic: [Option<Hit>; LANES],
-    one_by_one: [Option<ClosestHit>; LANES],
 }
 
 impl Default for ClosestLanes {
@@ -530,7 +518,6 @@ impl Default for ClosestLanes {
         let zero = F32x16::splat(0.0);
         ClosestLanes {
             hit: Mask16::NONE,
-            packet: false,
             best: BestLanes {
                 t: zero,
                 record: U32x16::splat(0),
@@ -539,7 +526,6 @@ impl Default for ClosestLanes {
                 hit: Mask16::NONE,
             },
             analytic: [None; LANES],
-            one_by_one: [None; LANES],
         }
     }
 }
@@ -553,9 +539,6 @@ impl ClosestLanes {
         rays: &RayLanes,
         i: usize,
     ) -> Option<ClosestHit> {
-        if !self.packet {
-            return self.one_by_one[i];
-        }
         if !self.hit.get(i) {
             return None;
         }
@@ -594,12 +577,7 @@ impl Geometry {
     /// scene with a tree.
     pub fn closest_hits_lanes(&self, rays: &RayLanes, m: Mask16, out: &mut ClosestLanes) {
         if !self.bvh.is_flat() {
-            out.packet = false;
-            out.one_by_one = [None; LANES];
-            for i in m.lanes() {
-                out.one_by_one[i] = self.closest_hit(&rays.lane(i));
-            }
-            out.hit = Mask16::from_fn(|i| out.one_by_one[i].is_some());
+            self.closest_hits_one_by_one(rays, m, out);
             return;
         }
         let scaled = ScaledRayLanes::new(rays);
@@ -612,11 +590,47 @@ impl Geometry {
             let s = &scaled.lanes()[i];
             TriangleRay::new(s.o, s.d)
         };
-        out.packet = true;
         self.bvh
             .packet()
             .closest(self.bvh.records(), &tri, tri_ray, t_max, m, &mut out.best);
         out.hit = out.best.hit | analytic;
+    }
+
+    /// `closest_hits_lanes` through the tree, one ray at a time (`closest_hit`), each
+    /// lane's hit written where the sixteen-ray test writes it (so that the surface data
+    /// of triangle hits is computed in lanes all the same).
+    fn closest_hits_one_by_one(&self, rays: &RayLanes, m: Mask16, out: &mut ClosestLanes) {
+        let mut t = [0.0f32; LANES];
+        let mut record = [0u32; LANES];
+        let mut e = [[0.0f32; LANES]; 3];
+        let mut det = [0.0f32; LANES];
+        let (mut triangles, mut any) = (Mask16::NONE, Mask16::NONE);
+        out.analytic = [None; LANES];
+        for i in m.lanes() {
+            let Some(r) = ScaledRay::new(&rays.lane(i)) else {
+                continue;
+            };
+            match self.closest_scaled::<false>(&r) {
+                Some(Hit::Triangle { record: id, hit }) => {
+                    (t[i], record[i], det[i]) = (hit.t, id, hit.det);
+                    for (k, e) in e.iter_mut().enumerate() {
+                        e[i] = hit.e[k];
+                    }
+                    triangles.set(i, true);
+                }
+                Some(other) => out.analytic[i] = Some(other),
+                None => continue,
+            }
+            any.set(i, true);
+        }
+        out.best = BestLanes {
+            t: F32x16::from_array(t),
+            record: U32x16::from_array(record),
+            e: e.map(F32x16::from_array),
+            det: F32x16::from_array(det),
+            hit: triangles,
+        };
+        out.hit = any;
     }
 
     /// `closest_analytic` for the lanes of `m`: spheres, then disks, in f64 lanes. Writes
@@ -707,12 +721,9 @@ impl Geometry {
         Mask16::from_halves(found[0], found[1])
     }
 
-    /// The surface data of `hits`: in lanes for the sixteen-ray test's hits, through
-    /// `interaction` lane by lane otherwise. Lane by lane the same bits as `interaction`.
+    /// The surface data of `hits`: in lanes for triangle hits, through `interaction` lane
+    /// by lane for spheres and disks. Lane by lane the same bits as `interaction`.
     pub fn surface_lanes(&self, hits: &ClosestLanes, rays: &RayLanes) -> SurfaceLanes {
-        if !hits.packet {
-            return self.surface_one_by_one(hits, rays, hits.hit);
-        }
         let triangles = self.triangle_surface_lanes(hits);
         // Sphere and disk hits through `interaction`, lane by lane.
         let analytic = hits.hit & !hits.best.hit;
@@ -732,15 +743,15 @@ impl Geometry {
         }
     }
 
-    /// `surface_lanes` for the lanes whose closest hit is a triangle the sixteen-ray test
-    /// found.
+    /// `surface_lanes` for the lanes whose closest hit is a triangle.
     #[inline(always)]
     fn triangle_surface_lanes(&self, hits: &ClosestLanes) -> SurfaceLanes {
         let best = &hits.best;
         let m = best.hit;
-        let packet = self.bvh.packet();
-        let table = packet.triangles.as_flattened();
-        let base = best.record.shl::<4>();
+        // Each record's twelve coordinates: the three vertices' x, y and z rows, each with
+        // an id in its fourth place.
+        let table = self.bvh.record_coordinates();
+        let base = best.record.shl::<3>() + best.record.shl::<2>();
         let at = |lane: u32| F32x16::gather(table, base + U32x16::splat(lane), m);
         let vertex = |j: u32| V3::new(at(j), at(4 + j), at(8 + j));
         let v = [vertex(0), vertex(1), vertex(2)];
@@ -749,7 +760,7 @@ impl Geometry {
         let b = best.e.map(|e| e * inv);
         let (p, p_error) = triangle::hit_point_in(v, b);
         let ng = (v[1] - v[0]).cross(v[2] - v[0]).normalize();
-        let ns = match &packet.normals {
+        let ns = match self.bvh.normal_coordinates() {
             None => ng,
             Some(normals) => {
                 // The interpolated vertex normal, normalised, where the record has normals
