@@ -15,6 +15,8 @@
 //! operations in the same order); the triangles are then tested within what is left of each segment.
 //! Scenes with a tree are answered one lane at a time by the per-ray queries.
 
+use super::offset::gamma;
+use super::sphere;
 use super::triangle::{self, BoundArithmetic, TriangleHit, TriangleRay, TriangleRecord};
 use super::{ClosestHit, Geometry, Hit, Ray, ScaledRay};
 use crate::math::lanes::{F32x16, F64x8, LANES, Mask8, Mask16, U32x16, V3};
@@ -571,6 +573,18 @@ pub struct SurfaceLanes {
     pub primitive: U32x16,
 }
 
+impl SurfaceLanes {
+    /// Takes the lanes of `m` from `other`.
+    fn merge(&mut self, m: Mask16, other: &SurfaceLanes) {
+        self.p = V3::select(m, other.p, self.p);
+        self.p_error = V3::select(m, other.p_error, self.p_error);
+        self.ng = V3::select(m, other.ng, self.ng);
+        self.ns = V3::select(m, other.ns, self.ns);
+        self.shape = U32x16::select(m, other.shape, self.shape);
+        self.primitive = U32x16::select(m, other.primitive, self.primitive);
+    }
+}
+
 impl Geometry {
     /// `closest_hit` for the rays of the lanes of `m`: the same answers, sixteen rays per
     /// triangle and sphere test on a small scene (`packet.rs`), one ray at a time on a
@@ -724,22 +738,90 @@ impl Geometry {
     /// The surface data of `hits`: in lanes for triangle hits, through `interaction` lane
     /// by lane for spheres and disks. Lane by lane the same bits as `interaction`.
     pub fn surface_lanes(&self, hits: &ClosestLanes, rays: &RayLanes) -> SurfaceLanes {
-        let triangles = self.triangle_surface_lanes(hits);
-        // Sphere and disk hits through `interaction`, lane by lane.
+        let mut surface = self.triangle_surface_lanes(hits);
+        surface.hit = hits.hit;
         let analytic = hits.hit & !hits.best.hit;
         if analytic.none() {
-            return triangles;
+            return surface;
         }
-        let other = self.surface_one_by_one(hits, rays, analytic);
-        let m = analytic;
+        // Spheres without (u, v) in lanes; disks and spheres with (u, v) through
+        // `interaction`, lane by lane.
+        let spheres = Mask16::from_fn(|i| {
+            analytic.get(i)
+                && matches!(hits.analytic[i], Some(Hit::Sphere { index, .. }) if !self.spheres[index].uv)
+        });
+        if spheres.any() {
+            surface.merge(spheres, &self.sphere_surface_lanes(hits, rays, spheres));
+        }
+        let others = analytic & !spheres;
+        if others.any() {
+            surface.merge(others, &self.surface_one_by_one(hits, rays, others));
+        }
+        surface
+    }
+
+    /// `surface_lanes` for the lanes of `m`, whose closest hits are spheres: `Sphere::hit`
+    /// without (u, v), each lane on its own sphere, in f64 lanes and then f32 ones, the same
+    /// operations and so the same bits.
+    fn sphere_surface_lanes(
+        &self,
+        hits: &ClosestLanes,
+        rays: &RayLanes,
+        m: Mask16,
+    ) -> SurfaceLanes {
+        let mut center = [[0.0f32; LANES]; 3];
+        let mut radius = [0.0f32; LANES];
+        let mut t = [0.0f64; LANES];
+        let (mut shape, mut flip) = ([0u32; LANES], Mask16::NONE);
+        for i in m.lanes() {
+            if let Some(Hit::Sphere { index, t: hit_t }) = hits.analytic[i] {
+                let s = &self.spheres[index];
+                for (k, c) in center.iter_mut().enumerate() {
+                    c[i] = s.center[k];
+                }
+                (radius[i], t[i], shape[i]) = (s.radius, hit_t, s.shape);
+                flip.set(i, s.flip_normals);
+            }
+        }
+        let center = center.map(F32x16::from_array);
+        let radius = F32x16::from_array(radius);
+        let (c_wide, r_wide) = (center.map(F32x16::to_f64_halves), radius.to_f64_halves());
+        let wide = WideRays::new(&ScaledRayLanes::new(rays));
+        let mut p = [(F64x8::splat(0.0), F64x8::splat(0.0)); 3];
+        let mut n = p;
+        for h in 0..2 {
+            let pick = |v: (F64x8, F64x8)| if h == 0 { v.0 } else { v.1 };
+            let (o, d) = wide.half(h);
+            let t = F64x8::from_array(std::array::from_fn(|i| t[8 * h + i]));
+            let (ph, nh) = sphere::reproject_lanes(&c_wide.map(pick), pick(r_wide), &o, &d, t);
+            for k in 0..3 {
+                let (pk, nk) = if h == 0 {
+                    (&mut p[k].0, &mut n[k].0)
+                } else {
+                    (&mut p[k].1, &mut n[k].1)
+                };
+                (*pk, *nk) = (ph[k], nh[k]);
+            }
+        }
+        let narrow = |v: [(F64x8, F64x8); 3]| {
+            let [x, y, z] = v.map(|(lo, hi)| F32x16::from_f64_halves(lo, hi));
+            V3::new(x, y, z)
+        };
+        let p = narrow(p);
+        let n = narrow(n).normalize();
+        let n = V3::select(flip, -n, n);
+        let [cx, cy, cz] = center;
+        let p_error = p.abs() * F32x16::splat(gamma(2))
+            + (V3::new(cx, cy, cz).abs() + V3::new(radius, radius, radius))
+                * F32x16::splat((2.0f32).powi(-46));
         SurfaceLanes {
-            hit: hits.hit,
-            p: V3::select(m, other.p, triangles.p),
-            p_error: V3::select(m, other.p_error, triangles.p_error),
-            ng: V3::select(m, other.ng, triangles.ng),
-            ns: V3::select(m, other.ns, triangles.ns),
-            shape: U32x16::select(m, other.shape, triangles.shape),
-            primitive: U32x16::select(m, other.primitive, triangles.primitive),
+            hit: m,
+            p,
+            p_error,
+            ng: n,
+            ns: n,
+            shape: U32x16::from_array(shape),
+            primitive: U32x16::splat(0),
         }
     }
 

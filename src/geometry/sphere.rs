@@ -157,6 +157,27 @@ impl Sphere {
     }
 }
 
+/// The f64 part of `Sphere::hit` for eight rays, each on its own sphere (centres `c` and
+/// radii `r` widened from f32): the hit `o + t·d` reprojected onto its sphere, and the unit
+/// normal there, lane by lane the same operations as `hit` and so the same bits.
+#[inline(always)]
+pub fn reproject_lanes(
+    c: &[F64x8; 3],
+    r: F64x8,
+    o: &[F64x8; 3],
+    d: &[F64x8; 3],
+    t: F64x8,
+) -> ([F64x8; 3], [F64x8; 3]) {
+    let n: [F64x8; 3] = std::array::from_fn(|k| (o[k] + d[k] * t) - c[k]);
+    let len = ((n[0] * n[0]) + (n[1] * n[1]) + (n[2] * n[2])).sqrt();
+    let positive = len.gt(F64x8::splat(0.0));
+    // `DVec3::Z` where the length is not positive (or NaN).
+    let n: [F64x8; 3] = std::array::from_fn(|k| {
+        F64x8::select(positive, n[k] / len, F64x8::splat((k == 2) as u8 as f64))
+    });
+    (std::array::from_fn(|k| c[k] + n[k] * r), n)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
