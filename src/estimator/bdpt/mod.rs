@@ -25,8 +25,10 @@ use super::camera_pass::{CameraEstimator, CameraSampleFn, start_camera_sample};
 use crate::error::{Error, Result};
 use crate::film::{Film, SplatList};
 use crate::geometry::Ray;
+use crate::geometry::packet::RayLanes;
 use crate::math::Rgb;
-use crate::path::connection::{self, Sampled, SubpathWeights};
+use crate::math::lanes::{F32x16, LANES, Mask16, V3};
+use crate::path::connection::{self, Connection, Sampled, SubpathWeights};
 pub use crate::path::mis::Heuristic;
 use crate::path::settings::PathSettings;
 use crate::path::subpath::{camera_subpath, light_subpath};
@@ -151,6 +153,8 @@ pub struct Scratch<'a> {
     camera_path: Vec<Vertex<'a>>,
     light_path: Vec<Vertex<'a>>,
     weights: SubpathWeights,
+    /// Connections waiting for their visibility test (`BdptSample::settle`).
+    group: ConnectionGroup<'a>,
 }
 
 impl<'a> Scratch<'a> {
@@ -213,6 +217,7 @@ impl BdptSample {
             camera_path,
             light_path,
             weights,
+            group,
         } = scratch;
         let (rays, invalid) = counts;
         let rr_depth = self.settings.path.rr_depth;
@@ -228,13 +233,23 @@ impl BdptSample {
         let settings = &self.settings;
         weights.fill(light_path, camera_path, settings.mis);
         let max_vertices = camera_vertices.saturating_add(1);
-        let mut pixel = Rgb::BLACK;
+        let hide = settings.path.hide_emitters;
+        let mut tally = Tally {
+            pixel: Rgb::BLACK,
+            rays,
+            invalid,
+            splats,
+            every_strategy,
+            observe: &mut observe,
+        };
+        // Connections wait in groups of sixteen so that their shadow rays are cast together
+        // (`Geometry::occluded_lanes`: sixteen rays per triangle test on a small scene);
+        // each group is then weighed in strategy order, so sums and splats keep their order.
         for t in 1..=camera_path.len() {
             for s in 0..=light_path.len() {
                 if s + t < 2 || s + t > max_vertices || (s == 0 && t == 1) {
                     continue;
                 }
-                let hide = settings.path.hide_emitters;
                 let Some(c) = connection::connect(
                     scene,
                     light_path,
@@ -251,53 +266,129 @@ impl BdptSample {
                     continue;
                 }
                 if !c.value.is_valid_radiance() {
-                    *invalid += 1;
+                    *tally.invalid += 1;
                     continue;
                 }
-                // Visibility before the weight: the weight's densities are spent only on
-                // connections that carry light.
-                if let Some(shadow) = &c.shadow {
-                    *rays += 1;
-                    if scene.geometry.occluded(shadow) {
-                        continue;
-                    }
-                }
-                let w = connection::weight(
-                    scene,
-                    light_path,
-                    camera_path,
-                    &c,
-                    s,
-                    t,
-                    settings.mis,
-                    hide,
-                    weights,
-                );
-                let value = c.value * w;
-                if value.is_black() && !every_strategy {
-                    continue;
-                }
-                if !value.is_valid_radiance() {
-                    *invalid += 1;
-                    continue;
-                }
-                observe(&StrategyEvent {
-                    s,
-                    t,
-                    light_path: &light_path[..s],
-                    camera_path: &camera_path[..t],
-                    sampled: c.sampled.as_ref(),
-                    weight: w,
-                    value: c.value,
-                    raster: c.raster,
-                });
-                match c.raster {
-                    Some(raster) => splats.push(raster, value),
-                    None => pixel += value,
+                group.push(s, t, c);
+                if group.is_full() {
+                    self.settle(scene, light_path, camera_path, weights, group, &mut tally);
                 }
             }
         }
-        pixel
+        self.settle(scene, light_path, camera_path, weights, group, &mut tally);
+        tally.pixel
+    }
+
+    /// Tests the visibility of `group`'s connections (as one packet of shadow rays), then
+    /// weighs the visible ones in order and adds them to the pixel or the splats; empties
+    /// the group.
+    fn settle<'a>(
+        &self,
+        scene: &'a Scene,
+        light_path: &[Vertex<'a>],
+        camera_path: &[Vertex<'a>],
+        weights: &SubpathWeights,
+        group: &mut ConnectionGroup<'a>,
+        tally: &mut Tally<'_, impl FnMut(&StrategyEvent)>,
+    ) {
+        if group.entries.is_empty() {
+            return;
+        }
+        let blocked = group.cast_shadows(scene, tally.rays);
+        let settings = &self.settings;
+        for (k, &(s, t, ref c)) in group.entries.iter().enumerate() {
+            if blocked.get(k) {
+                continue;
+            }
+            let w = connection::weight(
+                scene,
+                light_path,
+                camera_path,
+                c,
+                s,
+                t,
+                settings.mis,
+                settings.path.hide_emitters,
+                weights,
+            );
+            let value = c.value * w;
+            if value.is_black() && !tally.every_strategy {
+                continue;
+            }
+            if !value.is_valid_radiance() {
+                *tally.invalid += 1;
+                continue;
+            }
+            (tally.observe)(&StrategyEvent {
+                s,
+                t,
+                light_path: &light_path[..s],
+                camera_path: &camera_path[..t],
+                sampled: c.sampled.as_ref(),
+                weight: w,
+                value: c.value,
+                raster: c.raster,
+            });
+            match c.raster {
+                Some(raster) => tally.splats.push(raster, value),
+                None => tally.pixel += value,
+            }
+        }
+        group.entries.clear();
+    }
+}
+
+/// What a camera sample's strategies add up to, and where they go.
+struct Tally<'x, F> {
+    pixel: Rgb,
+    rays: &'x mut u64,
+    invalid: &'x mut u64,
+    splats: &'x mut SplatList,
+    every_strategy: bool,
+    observe: &'x mut F,
+}
+
+/// Up to sixteen connections (s, t, its contribution) waiting for their visibility test.
+#[derive(Default)]
+struct ConnectionGroup<'a> {
+    entries: Vec<(usize, usize, Connection<'a>)>,
+}
+
+impl<'a> ConnectionGroup<'a> {
+    fn push(&mut self, s: usize, t: usize, c: Connection<'a>) {
+        self.entries.push((s, t, c));
+    }
+
+    fn is_full(&self) -> bool {
+        self.entries.len() == LANES
+    }
+
+    /// The entries whose shadow ray is blocked (counting each ray cast in `rays`).
+    fn cast_shadows(&self, scene: &Scene, rays: &mut u64) -> Mask16 {
+        let mut lanes = [[0.0f32; LANES]; 7];
+        let mut m = Mask16::NONE;
+        for (k, (_, _, c)) in self.entries.iter().enumerate() {
+            if let Some(r) = &c.shadow {
+                for (a, v) in lanes
+                    .iter_mut()
+                    .zip([r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.t_max])
+                {
+                    a[k] = v;
+                }
+                m.set(k, true);
+            }
+        }
+        if m.none() {
+            return Mask16::NONE;
+        }
+        *rays += m.count() as u64;
+        let [ox, oy, oz, dx, dy, dz, t_max] = lanes.map(F32x16::from_array);
+        let shadows = RayLanes {
+            o: V3::new(ox, oy, oz),
+            d: V3::new(dx, dy, dz),
+            t_max,
+        };
+        scene.geometry.occluded_lanes(&shadows, m)
     }
 }
 
