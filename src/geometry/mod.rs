@@ -478,6 +478,17 @@ impl Geometry {
         }
     }
 
+    /// The (u, v) that `interaction(hit)` reports, without the rest of the surface data (for
+    /// a texture lookup).
+    pub fn uv(&self, hit: &ClosestHit) -> Vec2 {
+        let r = &hit.ray;
+        match hit.hit {
+            Hit::Triangle { record, hit: h } => self.triangle_uv(record, h.barycentrics()),
+            Hit::Sphere { index, t } => self.spheres[index].hit(r.o, r.d, t).uv,
+            Hit::Disk { index, local, .. } => self.disks[index].hit(local).uv,
+        }
+    }
+
     /// `out[i] = self.intersect(&rays[i])` for every ray, with several BVH traversals in
     /// flight (`bvh/stream.rs`): the same results, faster where the scene does not fit in the
     /// cache and each node read waits on memory.
@@ -572,6 +583,16 @@ impl Geometry {
             .any_in::<FLAT>(&TraversalRay::new(r.o, r.d), r.t_max)
     }
 
+    /// The (u, v) of barycentrics `b` on record `record`: its vertex uvs interpolated, or
+    /// (b1, b2) where its mesh has none.
+    #[inline(always)]
+    fn triangle_uv(&self, record: u32, b: [f32; 3]) -> Vec2 {
+        self.bvh
+            .uvs(record)
+            .map(|uv| uv[0] * b[0] + uv[1] * b[1] + uv[2] * b[2])
+            .unwrap_or(Vec2::new(b[1], b[2]))
+    }
+
     #[inline(always)]
     fn triangle_interaction(
         &self,
@@ -590,11 +611,7 @@ impl Geometry {
             .map(|n| (n[0] * b[0] + n[1] * b[1] + n[2] * b[2]).normalize_or_zero())
             .filter(|n| *n != Vec3::ZERO)
             .unwrap_or(ng);
-        let uv = self
-            .bvh
-            .uvs(record)
-            .map(|uv| uv[0] * b[0] + uv[1] * b[1] + uv[2] * b[2])
-            .unwrap_or(Vec2::new(b[1], b[2]));
+        let uv = self.triangle_uv(record, b);
         interaction(
             p,
             p_error,

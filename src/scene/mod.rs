@@ -70,9 +70,14 @@ impl Scene {
     /// or `roughplastic` one allocates).
     #[inline]
     pub fn bsdf_at(&self, si: &SurfaceInteraction) -> Cow<'_, Bsdf> {
-        let index = self.description.shapes[si.shape as usize].bsdf;
+        self.bsdf_at_uv(si.shape, si.uv)
+    }
+
+    /// `bsdf_at` for a hit on shape `shape` at (u, v) `uv` (all it reads of the hit).
+    pub fn bsdf_at_uv(&self, shape: u32, uv: glam::Vec2) -> Cow<'_, Bsdf> {
+        let index = self.description.shapes[shape as usize].bsdf;
         if self.textured[index] {
-            Cow::Owned(self.bsdfs[index].at_point(&self.description.bsdfs[index], si.uv))
+            Cow::Owned(self.bsdfs[index].at_point(&self.description.bsdfs[index], uv))
         } else {
             Cow::Borrowed(&self.bsdfs[index])
         }

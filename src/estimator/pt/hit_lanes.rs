@@ -66,6 +66,13 @@ impl HitLanes {
             (hit, p, p_error, ng, ns, shape);
     }
 
+    /// The (u, v) of lane `i`'s hit (as `interaction` would report it), if it hit.
+    pub fn uv(&self, scene: &Scene, i: usize) -> Option<glam::Vec2> {
+        self.closest
+            .closest_hit(&scene.geometry, &self.rays, i)
+            .map(|h| scene.geometry.uv(&h))
+    }
+
     /// The surface lane `i`'s ray hit, if any, as `Geometry::intersect` returns it.
     pub fn interaction(&self, scene: &Scene, i: usize) -> Option<SurfaceInteraction> {
         self.closest

@@ -184,11 +184,12 @@ impl LaneScene {
         }
         let textured = m & U32x16::gather(&self.textured, hits.shape, m).eq(one);
         let rgb = |c: Rgb| Vec3::new(c.r(), c.g(), c.b());
+        let shapes = hits.shape.to_array();
         for i in textured.lanes() {
-            let si = hits
-                .interaction(scene, i)
+            let uv = hits
+                .uv(scene, i)
                 .expect("a lane at a diffuse shape has a hit");
-            let (front, back, _) = diffuse_sides(&scene.bsdf_at(&si))
+            let (front, back, _) = diffuse_sides(&scene.bsdf_at_uv(shapes[i], uv))
                 .expect("a textured diffuse BSDF is diffuse at every point (Bsdf::at_point)");
             put3(&mut r.front, i, rgb(front));
             put3(&mut r.back, i, rgb(back));
