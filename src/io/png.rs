@@ -71,6 +71,9 @@ pub fn write_rgb8_png(path: &Path, width: u32, height: u32, bytes: &[u8]) -> Res
         encoder.set_color(png::ColorType::Rgb);
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_source_srgb(png::SrgbRenderingIntent::Perceptual);
+        // The fast deflate: at the default level a 512 × 512 preview took 2% of a 2-second
+        // `bdpt` render's CPU time; the file grows by about an eighth.
+        encoder.set_compression(png::Compression::Fast);
         let mut png_writer = encoder.write_header().map_err(png_error)?;
         png_writer.write_image_data(bytes).map_err(png_error)?;
         png_writer.finish().map_err(png_error)
