@@ -8,7 +8,9 @@ use glam::{DVec3, Vec2, Vec3};
 
 use super::AnalyticHit;
 use super::offset::gamma;
+use crate::math::fast_trig;
 use crate::math::lanes::{F64x8, Mask8};
+use std::f32::consts::PI;
 
 /// A sphere of `flip_normals` orientation, belonging to shape `shape`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -127,15 +129,16 @@ impl Sphere {
         let p_error = p.abs() * gamma(2)
             + (self.center.abs() + Vec3::splat(self.radius)) * (2.0f32).powi(-46);
         let uv = if self.uv {
-            let mut phi = n.y.atan2(n.x);
+            // The angles in f32 by `fast_trig` (within 4·10⁻⁷ rad: under 10⁻⁷ of the unit
+            // square, far below any texel), not libm's f64 atan2, which was 4% of `pt` on
+            // the textures scene.
+            let m = n.as_vec3();
+            let mut phi = fast_trig::atan2(m.y, m.x);
             if phi < 0.0 {
-                phi += 2.0 * std::f64::consts::PI;
+                phi += 2.0 * PI;
             }
-            let theta = (n.x.hypot(n.y)).atan2(n.z);
-            Vec2::new(
-                (phi / (2.0 * std::f64::consts::PI)) as f32,
-                (theta / std::f64::consts::PI) as f32,
-            )
+            let theta = fast_trig::atan2(m.x.hypot(m.y), m.z);
+            Vec2::new(phi / (2.0 * PI), theta / PI)
         } else {
             Vec2::ZERO
         };
