@@ -17,7 +17,10 @@ OUT/README.md and OUT/perf.csv. The meshes two scenes need are written on first 
 
 --binary times another build (e.g. an older commit's, built with `git worktree` and its own
 CARGO_TARGET_DIR) on this checkout's scenes, for before/after tables; the Mitsuba column
-always times this checkout's build (crosscheck_mitsuba.py).
+always times this checkout's build (crosscheck_mitsuba.py). --against OLD alternates the
+build with OLD render by render (OLD, new, OLD, new, ... --repeats pairs per cell), so that a
+machine whose speed drifts moves both alike, and writes OUT/against.md: both medians and
+their ratio per cell.
 
 Needs only the standard library (and a built `target/release/mltbench`).
 """
@@ -197,7 +200,12 @@ def main(argv):
     p.add_argument("--mitsuba", metavar="PYTHON", help="a Python with the mitsuba package")
     p.add_argument("--out", type=Path, default=REPO / "results" / "perf")
     p.add_argument("--binary", type=Path, default=BINARY, help="the mltbench build to time")
+    p.add_argument("--against", type=Path, metavar="OLD",
+                   help="another build, alternated with --binary render by render (against.md)")
     args = p.parse_args(argv)
+    if args.against and not args.against.exists():
+        print(f"error: --against {args.against} not found", file=sys.stderr)
+        return 2
     if not args.binary.exists():
         print(f"error: {args.binary} not found: run `cargo build --release` first", file=sys.stderr)
         return 2
@@ -221,16 +229,24 @@ def main(argv):
         for name, scene, covers in scenes:
             row = {"scene": name, "file": scene, "covers": covers}
             for label, est_args, spp in estimators:
-                rates, error = [], None
+                rates, old_rates, error = [], [], None
                 for _ in range(args.repeats):
+                    if args.against:
+                        rate, error = render_rate(args.against, scene, est_args, spp, args.threads, tmp)
+                        if rate is None:
+                            break
+                        old_rates.append(rate)
                     rate, error = render_rate(args.binary, scene, est_args, spp, args.threads, tmp)
                     if rate is None:
                         break
                     rates.append(rate)
                 row[label] = statistics.median(rates) if rates and error is None else None
                 row[label + "_error"] = error
+                if args.against and error is None:
+                    row[label + "_against"] = statistics.median(old_rates)
                 print(f"{name:14} {label:8} "
-                      + (f"{row[label]:.3f} M/s" if row[label] is not None else f"error: {error}"),
+                      + (f"{row[label]:.3f} M/s" if row[label] is not None else f"error: {error}")
+                      + (f" (against {row[label + '_against']:.3f})" if row.get(label + "_against") else ""),
                       file=sys.stderr)
             if args.mitsuba and name in NO_MITSUBA:
                 row["mitsuba_skipped"] = NO_MITSUBA[name]
@@ -255,8 +271,31 @@ def main(argv):
     return 0
 
 
+def write_against(args, rows, labels):
+    """OUT/against.md: per cell the medians of --against and --binary and their ratio."""
+    lines = [
+        "# Performance suite: two builds alternated",
+        "",
+        f"`perf_suite.py --repeats {args.repeats} --against {args.against} --binary {args.binary}`, "
+        f"{args.threads} threads, {time.strftime('%Y-%m-%d')}: renders of the two builds taken in "
+        f"turn, medians of {args.repeats} each, M samples/s as in README.md; old → new (new / old).",
+        "",
+        "| scene | " + " | ".join(labels) + " |",
+        "|---|" + "---|" * len(labels),
+    ]
+    for r in rows:
+        cells = [r["scene"]]
+        for k in labels:
+            old, new = r.get(k + "_against"), r.get(k)
+            cells.append(f"{old:.3f} → {new:.3f} ({new / old:.2f})" if old and new else "error")
+        lines.append("| " + " | ".join(cells) + " |")
+    (args.out / "against.md").write_text("\n".join(lines) + "\n")
+
+
 def write_outputs(args, rows, estimators):
     labels = [e[0] for e in estimators]
+    if args.against:
+        write_against(args, rows, labels)
     with (args.out / "perf.csv").open("w", newline="") as f:
         fields = ["scene", "file"] + labels + ["mitsuba_mpaths", "pt_pair_mpaths", "mitsuba_ratio"]
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
@@ -301,7 +340,8 @@ def write_outputs(args, rows, estimators):
     if errors:
         lines += ["", "Errors:", ""] + [f"- {s}, {k}: {e}" for s, k, e in errors]
     (args.out / "README.md").write_text("\n".join(lines) + "\n")
-    print(f"wrote {args.out / 'README.md'} and perf.csv", file=sys.stderr)
+    extra = " and against.md" if args.against else ""
+    print(f"wrote {args.out / 'README.md'}, perf.csv{extra}", file=sys.stderr)
 
 
 if __name__ == "__main__":
