@@ -294,6 +294,8 @@ impl BdptSample {
         if group.entries.is_empty() {
             return;
         }
+        // Visibility before the weights: their densities are spent only on connections
+        // that carry light.
         let blocked = group.cast_shadows(scene, tally.rays);
         let settings = &self.settings;
         for (k, &(s, t, ref c)) in group.entries.iter().enumerate() {
