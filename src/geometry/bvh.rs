@@ -29,7 +29,7 @@ mod stream;
 pub use stream::IN_FLIGHT;
 
 use super::cwbvh;
-use super::flat::{FLAT_LIMIT, FlatTriangles};
+use super::flat::{FLAT_LIMIT, FlatTriangles, LANE_LEAVES_LIMIT};
 use super::offset::gamma;
 use super::packet::PacketTriangles;
 use super::triangle::{TriangleHit, TriangleRay, TriangleRecord};
@@ -153,7 +153,8 @@ pub struct TriangleBvh {
     bounds: (Vec3, Vec3),
     /// The records laid out sixteen to a chunk (`flat.rs`). Up to `FLAT_LIMIT` triangles
     /// the queries test them all instead of walking a tree (`nodes` is then empty);
-    /// otherwise the tree's traversal tests each node's hit leaf triangles in these lanes.
+    /// otherwise the tree's traversal tests each node's hit leaf triangles in these lanes
+    /// (empty beyond `LANE_LEAVES_LIMIT` triangles: one by one there).
     lanes: FlatTriangles,
     /// The same records for sixteen rays at a time (`packet.rs`), also only when flat.
     packet: PacketTriangles,
@@ -228,7 +229,11 @@ impl TriangleBvh {
         };
         TriangleBvh {
             nodes,
-            lanes: FlatTriangles::new(&records),
+            lanes: if records.len() <= LANE_LEAVES_LIMIT {
+                FlatTriangles::new(&records)
+            } else {
+                FlatTriangles::default()
+            },
             packet,
             records,
             normals,

@@ -18,7 +18,8 @@
 //! test does, with the same t and edge functions; only the choice between hits at exactly
 //! equal t can differ from the tree's (here the lowest record index wins).
 //!
-//! Larger scenes keep the same chunks beside their tree: traversal tests each node's hit
+//! Larger scenes (up to `LANE_LEAVES_LIMIT` triangles) keep the same chunks beside their
+//! tree: traversal tests each node's hit
 //! leaf triangles (up to 24, contiguous in record order) in the lanes of the one to three
 //! chunks that hold them, the others masked off (`hits_of`). One vector test with one
 //! branch replaced a branchy per-triangle test per leaf triangle; `pt` on the 330k-triangle
@@ -35,6 +36,13 @@ const LANES: usize = 16;
 /// triangles flat closest hits run 13% faster than the tree's, at 68 closest hits are 4%
 /// faster and any hits 14% slower, at 132 both are 1.5–2× slower (`docs/performance.md`).
 pub const FLAT_LIMIT: usize = 48;
+
+/// Trees of at most this many triangles keep the chunks for `hits_of` (36 bytes more per
+/// triangle); larger ones test their leaf triangles one by one. Incoherent rays, one thread
+/// (`cargo bench --bench rays`): on 100k triangles the lanes ran 7% faster (9.28 → 9.91 M
+/// rays/s), on 1M 22% slower (1.97 → 1.54: nine cache lines per chunk against one record per
+/// triangle, in a tree beyond the cache); `pt` on the 330k-triangle mesh ran 12% faster.
+pub const LANE_LEAVES_LIMIT: usize = 500_000;
 
 /// Sixteen triangles, coordinates by axis, then vertex, then lane.
 #[derive(Clone, Copy)]
@@ -107,6 +115,20 @@ impl FlatTriangles {
         t_max: &mut f32,
         mut found: impl FnMut(usize, TriangleHit, &mut f32) -> bool,
     ) -> bool {
+        if self.chunks.is_empty() {
+            // A tree too large for the chunks (`LANE_LEAVES_LIMIT`): one by one.
+            let mut rest = bits;
+            while rest != 0 {
+                let index = (base + rest.trailing_zeros()) as usize;
+                rest &= rest - 1;
+                if let Some(h) = triangle::intersect(&records[index], r, *t_max)
+                    && found(index, h, t_max)
+                {
+                    return true;
+                }
+            }
+            return false;
+        }
         let first = base as usize / LANES;
         // The node's bits placed at their lanes from chunk `first` on (at most 24 + 15 bits).
         let mut lanes_wanted = (bits as u64) << (base as usize % LANES);

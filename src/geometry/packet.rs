@@ -621,10 +621,7 @@ impl Geometry {
         let (mut triangles, mut any) = (Mask16::NONE, Mask16::NONE);
         out.analytic = [None; LANES];
         for i in m.lanes() {
-            let Some(r) = ScaledRay::new(&rays.lane(i)) else {
-                continue;
-            };
-            match self.closest_scaled::<false>(&r) {
+            match self.closest_hit(&rays.lane(i)).map(|c| c.hit) {
                 Some(Hit::Triangle { record: id, hit }) => {
                     (t[i], record[i], det[i]) = (hit.t, id, hit.det);
                     for (k, e) in e.iter_mut().enumerate() {
