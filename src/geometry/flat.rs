@@ -19,11 +19,11 @@
 //! equal t can differ from the tree's (here the lowest record index wins).
 //!
 //! Larger scenes (up to `LANE_LEAVES_LIMIT` triangles) keep the same chunks beside their
-//! tree: traversal tests each node's hit
-//! leaf triangles (up to 24, contiguous in record order) in the lanes of the one to three
-//! chunks that hold them, the others masked off (`hits_of`). One vector test with one
-//! branch replaced a branchy per-triangle test per leaf triangle; `pt` on the 330k-triangle
-//! mesh ran 12% faster, on the 4k-triangle water mesh 3% (docs/performance.md).
+//! tree: traversal tests each node's hit leaf triangles (up to 24, contiguous in record
+//! order) in the lanes of the one to three chunks that hold them, the others masked off
+//! (`hits_of`). One vector test with one branch replaced a branchy per-triangle test per
+//! leaf triangle; `pt` on the 330k-triangle mesh ran 12% faster, on the 4k-triangle water
+//! mesh 3% (docs/performance.md).
 
 use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord};
 use crate::math::lanes::{F32x16, NATIVE, Real, U32x16};
