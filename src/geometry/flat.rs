@@ -529,6 +529,14 @@ mod tests {
                 expected.is_some(),
                 "ray {i}, base {base}, mask {mask:#x}"
             );
+            // Without chunks (a tree beyond `LANE_LEAVES_LIMIT`): the same, one by one.
+            let (mut one_by_one, mut t) = (None, t_max);
+            FlatTriangles::default().hits_of(&records, &r, base, mask, &mut t, |index, h, t| {
+                *t = h.t;
+                one_by_one = Some((index as u32, bits(&h)));
+                false
+            });
+            assert_eq!(one_by_one, expected, "ray {i}, no chunks");
             hits += expected.is_some() as u32;
         }
         assert!(hits > 2_000, "{hits}");
