@@ -548,7 +548,8 @@ fn pt_bits(scene: &Scene, params: &[&str], passes: u32, seed: u64) -> (Vec<u32>,
 /// `pt` traced sixteen paths at a time in SIMD lanes (`wavefront=true`) and one at a time
 /// (`wavefront=false`): the same image bits and the same counts, on every kind of scene the
 /// lanes treat differently (diffuse surfaces, textured or not, and smooth mirrors and glass
-/// in lanes, `twosided` diffuse ones from both sides, other BSDFs one lane at a time; small
+/// in lanes, `twosided` diffuse ones from both sides, other BSDFs in lanes around their
+/// scalar calls, `null` ones by the scalar code; small
 /// scenes cast sixteen rays per test, spheres included, trees one ray at a time; mesh
 /// lights sampled in lanes, other lights not; emitters hit, constant and envmap
 /// environments reached, point lights, thin lenses, sample patterns, every depth rule,
@@ -680,6 +681,63 @@ fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
         )),
         vec![],
     ));
+    // Every other kind of BSDF, which the lanes scatter around the scalar BSDF calls
+    // (`general_lanes.rs`): rough conductors (Beckmann, GGX), plastics smooth
+    // and rough, a rough and a thin dielectric, Phong, Blinn and Ward, a `twosided` rough
+    // conductor seen from behind; and a `null` cube, left to the scalar code.
+    let general = [
+        r#"<bsdf type="roughconductor"><float name="alpha" value="0.2"/></bsdf>"#,
+        r#"<bsdf type="roughconductor"><string name="distribution" value="ggx"/>
+            <float name="alpha" value="0.1"/></bsdf>"#,
+        r#"<bsdf type="plastic"><rgb name="diffuse_reflectance" value="0.2, 0.5, 0.7"/></bsdf>"#,
+        r#"<bsdf type="roughplastic"><float name="alpha" value="0.3"/></bsdf>"#,
+        r#"<bsdf type="roughdielectric"><float name="alpha" value="0.15"/></bsdf>"#,
+        r#"<bsdf type="thindielectric"/>"#,
+        r#"<bsdf type="phong"><float name="exponent" value="40"/></bsdf>"#,
+        r#"<bsdf type="blinn"><float name="exponent" value="60"/></bsdf>"#,
+        r#"<bsdf type="ward"><float name="alpha_u" value="0.2"/><float name="alpha_v" value="0.2"/></bsdf>"#,
+        r#"<bsdf type="twosided"><bsdf type="roughconductor"><float name="alpha" value="0.1"/></bsdf>
+            <bsdf type="diffuse"/></bsdf>"#,
+        r#"<bsdf type="null"/>"#,
+    ];
+    let spheres: String = general
+        .iter()
+        .enumerate()
+        .map(|(i, bsdf)| {
+            let (x, y) = ((i % 4) as f32 * 0.45 - 0.7, (i / 4) as f32 * 0.45 - 0.5);
+            // The twosided panel faces away from the camera.
+            let (shape, place) = if bsdf.contains("twosided") {
+                ("rectangle", format!(
+                    r#"<transform name="to_world"><scale value="0.2"/><rotate y="1" angle="160"/>
+                        <translate x="{x}" y="{y}" z="-2.5"/></transform>"#
+                ))
+            } else if bsdf.contains("null") {
+                ("cube", format!(
+                    r#"<transform name="to_world"><scale value="0.15"/>
+                        <translate x="{x}" y="{y}" z="-2.5"/></transform>"#
+                ))
+            } else {
+                ("sphere", format!(
+                    r#"<point name="center" x="{x}" y="{y}" z="-2.5"/><float name="radius" value="0.2"/>"#
+                ))
+            };
+            format!(r#"<shape type="{shape}">{place}{bsdf}</shape>"#)
+        })
+        .collect();
+    cases.push((
+        "rough and glossy BSDFs".into(),
+        scene(&format!(
+            r#"<scene version="3.0.0">
+                {camera}
+                {enclosure}
+                {CBOX_LIGHT_RECTANGLE}<emitter type="area"><rgb name="radiance" value="5"/></emitter></shape>
+                {spheres}
+            </scene>"#,
+            camera = camera(),
+            enclosure = enclosure("cube", "0.6", "0.1"),
+        )),
+        vec![],
+    ));
     // 6 cubes (72 triangles): more than a small scene, cast through the tree; a glass
     // sphere and a diffuse disk among them (analytic hits beside the tree's triangles).
     let cubes: String = (0..6)
@@ -729,14 +787,16 @@ fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
     }
 }
 
-/// On a scene whose vertices the lanes mostly hand to the scalar code (textures on every
-/// surface), `pt` with `wavefront=true` leaves the lanes after its first batches and goes
-/// on one path at a time: the image keeps the scalar image's bits across the switch.
+/// On a scene whose vertices the lanes mostly hand to the scalar code (every vertex on an
+/// emitting sphere, whose emission the lanes leave to it), `pt` with `wavefront=true`
+/// leaves the lanes after its first batches and goes on one path at a time: the image
+/// keeps the scalar image's bits across the switch.
 #[test]
 fn leaving_the_lanes_part_way_keeps_the_image_bits() {
-    let scene = shipped_scene("textures.xml", 64);
-    // 64 × 64 × 32 samples: past the 2^16 vertices after which the lanes' share decides.
-    let run = |wavefront: &str| pt_bits(&scene, &[wavefront], 32, 5);
+    let scene = furnace("sphere", "0.5", "1", -1, "");
+    // 32 × 32 × 96 samples of about two vertices: past the 2^16 vertices after which the
+    // lanes' share decides.
+    let run = |wavefront: &str| pt_bits(&scene, &[wavefront], 96, 5);
     let (lanes, one_by_one) = (run("wavefront=true"), run("wavefront=false"));
     assert_eq!(lanes.1, one_by_one.1, "counts");
     assert!(lanes.0 == one_by_one.0, "image bits differ");

@@ -1,5 +1,6 @@
 //! `PathSample::scatter` in lanes, for paths at a `diffuse` surface: next-event
-//! estimation, cosine-weighted sampling of the next direction, Russian roulette. Every
+//! estimation (its light sample and queued shadow ray shared with `general_lanes.rs`),
+//! cosine-weighted sampling of the next direction, Russian roulette. Every
 //! operation is the scalar code's, in its order (see `wavefront.rs`), with the scalar
 //! code's early returns turned into lane masks.
 
@@ -22,27 +23,27 @@ use crate::scene::Scene;
 use glam::{Vec2, Vec3};
 
 /// What next-event estimation drew per lane: the light's choice and `Light::sample_li`.
-struct NeeLanes {
+pub(super) struct NeeLanes {
     /// Lanes with a sample (a light was chosen and returned a point).
-    ok: Mask16,
-    p: V3<F32x16>,
-    n: V3<F32x16>,
-    p_error: V3<F32x16>,
-    wi: V3<F32x16>,
+    pub(super) ok: Mask16,
+    pub(super) p: V3<F32x16>,
+    pub(super) n: V3<F32x16>,
+    pub(super) p_error: V3<F32x16>,
+    pub(super) wi: V3<F32x16>,
     /// The point is at a finite distance (not a light at infinity).
-    finite: Mask16,
-    radiance: V3<F32x16>,
-    pdf_solid_angle: F32x16,
+    pub(super) finite: Mask16,
+    pub(super) radiance: V3<F32x16>,
+    pub(super) pdf_solid_angle: F32x16,
     /// Probability of having chosen the light.
-    pmf: F32x16,
-    delta: Mask16,
+    pub(super) pmf: F32x16,
+    pub(super) delta: Mask16,
 }
 
 impl NeeLanes {
     /// Chooses a light and a point on it for every lane of `m` (as `sample_light` does):
     /// in lanes for the lights that can (`Light::sample_li_lanes`), one lane at a time for
     /// the others.
-    fn sample(
+    pub(super) fn sample(
         scene: &Scene,
         p: &V3<F32x16>,
         u_light: F32x16,
@@ -135,6 +136,70 @@ pub(super) fn power_heuristic_lanes(pdf_a: F32x16, pdf_b: F32x16, m: Mask16) -> 
     w
 }
 
+/// The end of `PathSample::light_contribution` in lanes, for every BSDF the lanes scatter
+/// at: the shadow ray of light sample `ls` and the MIS-weighted f · Le / p it carries,
+/// queued (`ShadowQueue`), for the lanes of `adds` (those where the scalar code adds a
+/// contribution: a light sample at a vertex a connection may end at). `f` is the BSDF's
+/// value times |cos θi| towards the sample, `bsdf_pdf` its density of sampling that
+/// direction.
+pub(super) fn queue_light_sample(
+    lanes: &mut PathLanes,
+    hits: &HitLanes,
+    ls: &NeeLanes,
+    f: V3<F32x16>,
+    bsdf_pdf: F32x16,
+    adds: Mask16,
+    shadows: &mut ShadowQueue,
+) {
+    let zero = F32x16::splat(0.0);
+    let zero3 = V3::new(zero, zero, zero);
+    let black = f.x.eq(zero) & f.y.eq(zero) & f.z.eq(zero);
+    let shoot = adds & !black;
+    // The shadow ray: to the light's point, both ends offset off their surfaces, or
+    // towards a light at infinity.
+    let to_point = ls.finite;
+    let o_to_point = offset_origin(hits.p, hits.p_error, hits.ng, ls.p - hits.p);
+    let target = offset_origin(ls.p, ls.p_error, ls.n, o_to_point - ls.p);
+    let o_away = offset_origin(hits.p, hits.p_error, hits.ng, ls.wi);
+    let origin = V3::select(to_point, o_to_point, o_away);
+    let dir = V3::select(to_point, target - o_to_point, ls.wi);
+    let t_max = F32x16::select(
+        to_point,
+        F32x16::splat(1.0 - SHADOW_EPSILON),
+        F32x16::splat(f32::INFINITY),
+    );
+    lanes.rays = lanes.rays + U32x16::select(shoot, U32x16::splat(1), U32x16::splat(0));
+    let pdf_light = ls.pmf * ls.pdf_solid_angle;
+    let weight = F32x16::select(
+        ls.delta,
+        F32x16::splat(1.0),
+        power_heuristic_lanes(pdf_light, bsdf_pdf, shoot & !ls.delta),
+    );
+    // What each lane adds: throughput × contribution if its shadow ray is unoccluded,
+    // throughput × black otherwise (and without a shadow ray). The latter is +0, which
+    // changes no sum, unless the throughput is not finite: those lanes queue it too,
+    // with a shadow ray of no length (never occluded), so that it is added in order.
+    let contribution = f.mul_v(ls.radiance) * (weight / pdf_light);
+    let lit = lanes.throughput.mul_v(contribution);
+    let dark = lanes.throughput.mul_v(zero3);
+    let signed_zero = |v: F32x16| v.to_bits().eq(U32x16::splat(0));
+    let no_op = signed_zero(dark.x) & signed_zero(dark.y) & signed_zero(dark.z);
+    let odd = adds & !shoot & !no_op;
+    let queued = shoot | odd;
+    let shadow = RayLanes {
+        o: origin,
+        d: dir,
+        t_max: F32x16::select(shoot, t_max, zero),
+    };
+    shadows.push(
+        queued,
+        &shadow,
+        &V3::select(shoot, lit, dark),
+        &dark,
+        U32x16::from_array(lanes.sample),
+    );
+}
+
 impl PathSample {
     /// `scatter` for the lanes of `m` (live, at a `diffuse` surface, textured or not). Returns
     /// the lanes whose path ends here.
@@ -169,57 +234,13 @@ impl PathSample {
         // Diffuse::eval: R/π where both directions are above the surface, black elsewhere.
         let above = wo.z.gt(zero) & wi.z.gt(zero);
         let f = V3::select(above, rho * inv_pi, zero3) * wi.z.abs();
-        let black = f.x.eq(zero) & f.y.eq(zero) & f.z.eq(zero);
-        let shoot = m & ls.ok & !black;
-        // The shadow ray: to the light's point, both ends offset off their surfaces, or
-        // towards a light at infinity.
-        let to_point = ls.finite;
-        let o_to_point = offset_origin(hits.p, hits.p_error, hits.ng, ls.p - hits.p);
-        let target = offset_origin(ls.p, ls.p_error, ls.n, o_to_point - ls.p);
-        let o_away = offset_origin(hits.p, hits.p_error, hits.ng, ls.wi);
-        let origin = V3::select(to_point, o_to_point, o_away);
-        let dir = V3::select(to_point, target - o_to_point, ls.wi);
-        let t_max = F32x16::select(
-            to_point,
-            F32x16::splat(1.0 - SHADOW_EPSILON),
-            F32x16::splat(f32::INFINITY),
-        );
-        lanes.rays = lanes.rays + U32x16::select(shoot, U32x16::splat(1), U32x16::splat(0));
-        let pdf_light = ls.pmf * ls.pdf_solid_angle;
         // Diffuse::pdf: the cosine density where wo is above the surface.
         let bsdf_pdf = F32x16::select(
             wo.z.gt(zero),
             F32x16::select(wi.z.gt(zero), wi.z * inv_pi, zero),
             zero,
         );
-        let weight = F32x16::select(
-            ls.delta,
-            F32x16::splat(1.0),
-            power_heuristic_lanes(pdf_light, bsdf_pdf, shoot & !ls.delta),
-        );
-        // What each lane adds: throughput × contribution if its shadow ray is unoccluded,
-        // throughput × black otherwise (and without a shadow ray). The latter is +0, which
-        // changes no sum, unless the throughput is not finite: those lanes queue it too,
-        // with a shadow ray of no length (never occluded), so that it is added in order.
-        let contribution = f.mul_v(ls.radiance) * (weight / pdf_light);
-        let lit = lanes.throughput.mul_v(contribution);
-        let dark = lanes.throughput.mul_v(zero3);
-        let signed_zero = |v: F32x16| v.to_bits().eq(U32x16::splat(0));
-        let no_op = signed_zero(dark.x) & signed_zero(dark.y) & signed_zero(dark.z);
-        let odd = m & !shoot & !no_op;
-        let queued = shoot | odd;
-        let shadow = RayLanes {
-            o: origin,
-            d: dir,
-            t_max: F32x16::select(shoot, t_max, zero),
-        };
-        shadows.push(
-            queued,
-            &shadow,
-            &V3::select(shoot, lit, dark),
-            &dark,
-            U32x16::from_array(lanes.sample),
-        );
+        queue_light_sample(lanes, hits, &ls, f, bsdf_pdf, m & ls.ok, shadows);
 
         // BSDF sampling (`Diffuse::sample`): the next segment.
         // The walk's four numbers (`Walk::scatter`): component, direction, roulette.

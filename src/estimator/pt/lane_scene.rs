@@ -37,6 +37,9 @@ pub(super) struct LaneScene {
     pub light: Vec<u32>,
     /// The smooth specular BSDFs the lanes sample (`specular_lanes.rs`), by shape.
     pub specular: SpecularTables,
+    /// 1 where the BSDF is not `null`: the lanes scatter there with the scalar BSDF calls
+    /// (`general_lanes.rs`) when neither the diffuse nor the specular lanes do.
+    pub general: Vec<u32>,
 }
 
 /// Which shapes have a smooth specular BSDF the lanes sample, and its parameters.
@@ -73,6 +76,7 @@ impl LaneScene {
         };
         let (mut reflectance, mut back_reflectance) = (channels(), channels());
         let mut light = vec![NO_LIGHT; n.max(1)];
+        let mut general = vec![0u32; n.max(1)];
         let mut specular = SpecularTables {
             kind: vec![0; n.max(1)],
             any: false,
@@ -117,6 +121,7 @@ impl LaneScene {
             if let Some(l) = scene.lights.light_of_shape(shape) {
                 light[shape] = l as u32;
             }
+            general[shape] = !scene.bsdf_of_shape(shape as u32).is_null() as u32;
         }
         LaneScene {
             diffuse,
@@ -128,6 +133,7 @@ impl LaneScene {
             back_reflectance,
             light,
             specular,
+            general,
         }
     }
 }

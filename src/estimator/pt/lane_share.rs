@@ -1,12 +1,13 @@
 //! How much of a scene's path vertices `pt`'s SIMD lanes handle themselves, measured while
 //! it renders, and the choice it drives.
 //!
-//! The lanes scatter on diffuse surfaces (textured or not), smooth mirrors and glass, and
-//! add the emission of area lights and of the environment; every other vertex (rough and
-//! glossy BSDFs, plastic, other emitters) is handed to the scalar code one lane at a time,
-//! which costs a transposition of the path's state out of the lanes and back. Where most
-//! vertices go that way, tracing one path at a time is faster (10–20% on scenes made
-//! mostly of such surfaces).
+//! The lanes scatter at every surface but `null` ones (diffuse, smooth mirrors and glass
+//! in lane arithmetic, other BSDFs around their scalar calls) and add the emission of area
+//! lights on meshes and disks and of the environment; every other vertex (`null` surfaces,
+//! other emitters) is handed to the scalar code one lane at a time, which costs a
+//! transposition of the path's state out of the lanes and back. Where most vertices go that
+//! way, tracing one path at a time is faster (10–20% on scenes made mostly of such
+//! surfaces, when rough BSDFs went that way too).
 //! The image is the same bit for bit either way (`tests/pt.rs`), so the choice, made
 //! batch by batch from the counts so far, changes only the speed.
 

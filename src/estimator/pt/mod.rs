@@ -24,6 +24,7 @@ use glam::{Vec2, Vec3};
 use super::Params;
 mod diffuse_lanes;
 mod environment_lanes;
+mod general_lanes;
 mod hit_lanes;
 mod lane_scene;
 mod lane_share;

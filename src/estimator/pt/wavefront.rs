@@ -339,11 +339,11 @@ impl PathSample {
         let deep = !(lanes.depth + one).lt(U32x16::splat(self.max_depth()));
         ended |= hits.hit & !scalar_emitters & deep;
 
-        // Scattering: diffuse and smooth specular surfaces in lanes, the others one by one.
+        // Scattering: diffuse and smooth specular surfaces in lanes, the other BSDFs in lanes
+        // around their scalar calls, `null` ones one by one.
         let going = live & !ended;
         let diffuse = going & U32x16::gather(&tables.diffuse, hits.shape, going).eq(one);
         ended |= self.scatter_diffuse(scene, tables, lanes, hits, diffuse, shadows);
-        shadows.cast_full(&scene.geometry, queue);
         let specular = if tables.specular.any {
             let kind = U32x16::gather(&tables.specular.kind, hits.shape, going & !diffuse);
             going & !diffuse & !kind.eq(zero)
@@ -353,7 +353,14 @@ impl PathSample {
         if specular.any() {
             ended |= self.scatter_specular(&tables.specular, lanes, hits, specular);
         }
-        let scalar = going & !diffuse & !specular;
+        // Every other BSDF but `null`: in lanes around the scalar BSDF calls.
+        let rest = going & !diffuse & !specular;
+        let general = rest & U32x16::gather(&tables.general, hits.shape, rest).eq(one);
+        if general.any() {
+            ended |= self.scatter_general(scene, lanes, hits, general, shadows);
+        }
+        shadows.cast_full(&scene.geometry, queue);
+        let scalar = rest & !general;
         coverage.scalar += scalar.count() as u64;
         for lane in scalar.lanes() {
             let mut state = self.take_path(scene, lanes, lane, queue, shadows);
