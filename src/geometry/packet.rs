@@ -15,6 +15,7 @@
 //! operations in the same order); the triangles are then tested within what is left of each segment.
 //! Scenes with a tree are answered one lane at a time by the per-ray queries.
 
+use super::bvh::TraversalRay;
 use super::offset::gamma;
 use super::sphere;
 use super::triangle::{self, BoundArithmetic, TriangleHit, TriangleRay, TriangleRecord};
@@ -618,22 +619,31 @@ impl Geometry {
         let mut record = [0u32; LANES];
         let mut e = [[0.0f32; LANES]; 3];
         let mut det = [0.0f32; LANES];
-        let (mut triangles, mut any) = (Mask16::NONE, Mask16::NONE);
-        out.analytic = [None; LANES];
-        for i in m.lanes() {
-            match self.closest_hit(&rays.lane(i)).map(|c| c.hit) {
-                Some(Hit::Triangle { record: id, hit }) => {
-                    (t[i], record[i], det[i]) = (hit.t, id, hit.det);
-                    for (k, e) in e.iter_mut().enumerate() {
-                        e[i] = hit.e[k];
-                    }
-                    triangles.set(i, true);
-                }
-                Some(other) => out.analytic[i] = Some(other),
-                None => continue,
-            }
-            any.set(i, true);
+        let mut triangles = Mask16::NONE;
+        // `closest_hit_in`'s steps: the analytic shapes first (in lanes), then the tree
+        // within what they left of each segment (one ray at a time).
+        let scaled = ScaledRayLanes::new(rays);
+        let m = m & scaled.valid;
+        let (analytic, t_max) = self.closest_analytic_lanes(&scaled, m, &mut out.analytic);
+        if !self.has_analytic_shapes() {
+            out.analytic = [None; LANES];
         }
+        let (t_max, scaled) = (t_max.to_array(), scaled.lanes());
+        for i in m.lanes() {
+            let s = &scaled[i];
+            if let Some((id, hit)) = self
+                .bvh
+                .closest_in::<false>(&TraversalRay::new(s.o, s.d), t_max[i])
+            {
+                (t[i], record[i], det[i]) = (hit.t, id, hit.det);
+                for (k, e) in e.iter_mut().enumerate() {
+                    e[i] = hit.e[k];
+                }
+                triangles.set(i, true);
+                out.analytic[i] = None;
+            }
+        }
+        let any = triangles | analytic;
         out.best = BestLanes {
             t: F32x16::from_array(t),
             record: U32x16::from_array(record),
@@ -903,15 +913,24 @@ impl Geometry {
     /// `occluded` for the rays of the lanes of `m`: the lanes whose segment is blocked
     /// (sixteen rays per triangle test where `closest_hits_lanes` uses it).
     pub fn occluded_lanes(&self, rays: &RayLanes, m: Mask16) -> Mask16 {
-        if !self.bvh.is_flat() {
-            return Mask16::from_fn(|i| m.get(i) && self.occluded(&rays.lane(i)));
-        }
         let scaled = ScaledRayLanes::new(rays);
         let m = m & scaled.valid;
         let blocked = self.analytic_blocks_lanes(&scaled, m);
         let m = m & !blocked;
         if m.none() {
             return blocked;
+        }
+        if !self.bvh.is_flat() {
+            // The tree one ray at a time, for what the analytic shapes left.
+            let scaled = scaled.lanes();
+            let t_max = scaled.map(|s| s.t_max);
+            return blocked
+                | Mask16::from_fn(|i| {
+                    m.get(i)
+                        && self
+                            .bvh
+                            .any_in::<false>(&TraversalRay::new(scaled[i].o, scaled[i].d), t_max[i])
+                });
         }
         let tri = TriangleRayLanes::new(&scaled.o, &scaled.d);
         let tri_ray = |i: usize| {
