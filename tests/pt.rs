@@ -738,6 +738,31 @@ fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
         )),
         vec![],
     ));
+    // Sphere lights, sampled through their cones in lanes (`sphere_lanes.rs`): a small
+    // and a large one seen from outside, and a third with a diffuse BSDF, so that paths
+    // also scatter on an emitting sphere (sampled by area from there, by the scalar code).
+    cases.push((
+        "sphere lights".into(),
+        scene(&format!(
+            r#"<scene version="3.0.0">
+                {camera}
+                {enclosure}
+                <shape type="sphere"><point name="center" x="-0.5" y="0.4" z="-2.5"/>
+                    <float name="radius" value="0.05"/>
+                    <emitter type="area"><rgb name="radiance" value="40"/></emitter></shape>
+                <shape type="sphere"><point name="center" x="0.5" y="0.3" z="-2.8"/>
+                    <float name="radius" value="0.3"/>
+                    <emitter type="area"><rgb name="radiance" value="2, 3, 4"/></emitter></shape>
+                <shape type="sphere"><point name="center" x="0" y="-0.4" z="-2.3"/>
+                    <float name="radius" value="0.25"/>
+                    <bsdf type="diffuse"><rgb name="reflectance" value="0.6"/></bsdf>
+                    <emitter type="area"><rgb name="radiance" value="0.5"/></emitter></shape>
+            </scene>"#,
+            camera = camera(),
+            enclosure = enclosure("cube", "0.6", "0"),
+        )),
+        vec![],
+    ));
     // 6 cubes (72 triangles): more than a small scene, cast through the tree; a glass
     // sphere and a diffuse disk among them (analytic hits beside the tree's triangles).
     let cubes: String = (0..6)

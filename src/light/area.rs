@@ -107,8 +107,8 @@ impl AreaLight {
     }
 
     /// `le` towards `w` and `pdf_li` from `r` at hit points (`p`, `n`, `front`), per lane,
-    /// as `le` and `pdf_li` compute them; None where the shape's density is not done in
-    /// lanes (spheres).
+    /// as `le` and `pdf_li` compute them (None is kept for shapes whose density is not done
+    /// in lanes; every shape's is).
     #[inline]
     pub fn emission_lanes(
         &self,

@@ -449,7 +449,8 @@ impl Light {
 
     /// `sample_li` for the lanes of `m` (reference points `r`, 2D samples `ux`, `uy`),
     /// lane by lane the same bits; None for lights the lanes cannot sample (all but point
-    /// lights, lights at infinity and area lights on meshes without vertex normals).
+    /// lights, lights at infinity, area lights on meshes without vertex normals and on
+    /// spheres seen from outside).
     #[inline]
     pub fn sample_li_lanes(
         &self,
@@ -479,8 +480,8 @@ impl Light {
     /// For rays that hit this light at points `p` (geometric normal `n`, emitting side
     /// `front`) travelling towards `w` (unit, away from the light), from reference points
     /// `r`: `le` and `pdf_li` (Light's cleaning included), lane by lane the same bits as the
-    /// scalar functions; None for lights the lanes cannot do (all but area lights on meshes
-    /// and disks).
+    /// scalar functions; None for lights the lanes cannot do (all but area lights on meshes,
+    /// disks and spheres).
     #[inline]
     pub fn emission_lanes(
         &self,
