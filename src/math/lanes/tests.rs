@@ -331,20 +331,27 @@ fn integer_lane_operations_equal_scalar_ones() {
 
 #[test]
 fn gathers_read_their_lanes_and_clamp_indices() {
-    let table: Vec<f32> = (0..10).map(|i| i as f32 * 1.5).collect();
-    let ints: Vec<u32> = (0..10).map(|i| i * 7).collect();
     let idx = U32x16::from_array(std::array::from_fn(|i| (i as u32 * 3) % 13));
     let m = Mask16(0b1011_0111_1101_1110);
-    let got = F32x16::gather(&table, idx, m).to_array();
-    let got_int = U32x16::gather(&ints, idx, m).to_array();
-    for i in 0..16 {
-        let j = ((i * 3) % 13).min(9);
-        let (want, want_int) = if m.get(i) {
-            (table[j], ints[j])
-        } else {
-            (0.0, 0)
-        };
-        assert_eq!((got[i], got_int[i]), (want, want_int), "lane {i}");
+    // Tables permuted in one register (at most sixteen entries) and gathered (more).
+    for n in [1usize, 10, 16, 17, 40] {
+        let table: Vec<f32> = (0..n).map(|i| i as f32 * 1.5).collect();
+        let ints: Vec<u32> = (0..n as u32).map(|i| i * 7).collect();
+        let got = F32x16::gather(&table, idx, m).to_array();
+        let got_int = U32x16::gather(&ints, idx, m).to_array();
+        for i in 0..16 {
+            let j = ((i * 3) % 13).min(n - 1);
+            let (want, want_int) = if m.get(i) {
+                (table[j], ints[j])
+            } else {
+                (0.0, 0)
+            };
+            assert_eq!(
+                (got[i], got_int[i]),
+                (want, want_int),
+                "{n} entries, lane {i}"
+            );
+        }
     }
     let wide: Vec<f64> = (0..10).map(|i| i as f64 * 0.25 - 1.0).collect();
     let (idx_lo, _) = idx.to_u64_halves();
