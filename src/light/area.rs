@@ -86,7 +86,7 @@ impl AreaLight {
         let dist = d.length();
         let wi = d.div_scalar(dist);
         // One-sided, as `sample_li` (false for NaN too).
-        let faces_r = s.point.n.dot(wi).lt(F32x16::splat(0.0));
+        let faces_r = s.point.front.dot(wi).lt(F32x16::splat(0.0));
         let c = |v: f32| F32x16::splat(v);
         Some(LightSampleLanes {
             ok: s.ok & dist.gt(c(0.0)) & faces_r,

@@ -449,8 +449,7 @@ impl Light {
 
     /// `sample_li` for the lanes of `m` (reference points `r`, 2D samples `ux`, `uy`),
     /// lane by lane the same bits; None for lights the lanes cannot sample (all but point
-    /// lights, lights at infinity, area lights on meshes without vertex normals and on
-    /// spheres seen from outside).
+    /// lights, lights at infinity, area lights on meshes and on spheres seen from outside).
     #[inline]
     pub fn sample_li_lanes(
         &self,

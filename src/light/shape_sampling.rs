@@ -122,8 +122,7 @@ impl ShapeSampler {
     }
 
     /// `sample_from` for the lanes of `m`, lane by lane the same bits; None where the lanes
-    /// cannot sample this shape (disks, meshes with vertex normals, spheres from a point on
-    /// them).
+    /// cannot sample this shape (disks, spheres from a point on them).
     #[inline]
     pub fn sample_from_lanes(
         &self,
@@ -214,9 +213,8 @@ pub struct MeshSampler {
     /// Over the kept triangles, by area.
     by_area: Distribution1D,
     area: f32,
-    /// The triangles laid out for gathers by lane, when the lanes can sample this mesh
-    /// (it has no vertex normals).
-    lanes: Option<Box<MeshLanes>>,
+    /// The triangles laid out for gathers by lane.
+    lanes: Box<MeshLanes>,
 }
 
 /// Each kept triangle's vertex coordinates (v0.x, v0.y, v0.z, v1.x, …, v2.z) and normal
@@ -224,13 +222,17 @@ pub struct MeshSampler {
 #[derive(Clone, Debug, PartialEq)]
 struct MeshLanes {
     coords: [Vec<f32>; 12],
+    /// The vertex normals' coordinates (n0.x, n0.y, …, n2.z), when the mesh has them.
+    vertex_normals: Option<[Vec<f32>; 9]>,
 }
 
-/// Points on a shape, one per lane (see `ShapePoint`; `front` is `n` for them).
+/// Points on a shape, one per lane (see `ShapePoint`).
 #[derive(Clone, Copy, Debug)]
 pub struct ShapePointLanes {
     pub p: V3<F32x16>,
     pub n: V3<F32x16>,
+    /// Which side emits (`ShapePoint::front`).
+    pub front: V3<F32x16>,
     pub p_error: V3<F32x16>,
 }
 
@@ -283,20 +285,24 @@ impl MeshSampler {
         if !(area > 0.0 && area.is_finite()) {
             return Err(format!("the emitting mesh has an unusable area ({total})"));
         }
-        let lanes = vertex_normals.is_none().then(|| {
-            let coords = std::array::from_fn(|k| {
-                (0..triangles.len())
-                    .map(|t| {
-                        let v = if k < 9 {
-                            triangles[t][k / 3]
-                        } else {
-                            normals[t]
-                        };
-                        v[k % 3]
-                    })
-                    .collect()
-            });
-            Box::new(MeshLanes { coords })
+        let coords = std::array::from_fn(|k| {
+            (0..triangles.len())
+                .map(|t| {
+                    let v = if k < 9 {
+                        triangles[t][k / 3]
+                    } else {
+                        normals[t]
+                    };
+                    v[k % 3]
+                })
+                .collect()
+        });
+        let lane_normals = vertex_normals.as_ref().map(|vn: &Vec<[Vec3; 3]>| {
+            std::array::from_fn(|k| vn.iter().map(|n| n[k / 3][k % 3]).collect())
+        });
+        let lanes = Box::new(MeshLanes {
+            coords,
+            vertex_normals: lane_normals,
         });
         Ok(MeshSampler {
             triangles,
@@ -338,20 +344,37 @@ impl MeshSampler {
         }
     }
 
-    /// `sample_area` for the lanes of `m`, lane by lane the same bits; None for a mesh with
-    /// vertex normals (sampled one lane at a time).
+    /// `sample_area` for the lanes of `m`, lane by lane the same bits.
     #[inline]
     pub fn sample_area_lanes(&self, ux: F32x16, uy: F32x16, m: Mask16) -> Option<ShapePointLanes> {
-        let lanes = self.lanes.as_ref()?;
+        let lanes = &self.lanes;
         let (i, _, ux) = self.by_area.sample_discrete_lanes(ux, m);
         let (b1, b2) = warp::triangle_barycentrics(ux, uy);
         let g = |k: usize| F32x16::gather(&lanes.coords[k], i, m);
         let vertex = |j: usize| V3::new(g(3 * j), g(3 * j + 1), g(3 * j + 2));
         let (v0, v1, v2) = (vertex(0), vertex(1), vertex(2));
         let b0 = F32x16::splat(1.0) - b1 - b2;
+        let n = vertex(3);
+        let front = match &lanes.vertex_normals {
+            None => n,
+            Some(vn) => {
+                // `interpolated_normal`: the normalised interpolation, or n where it
+                // vanishes (`normalize_or_zero`'s test on the reciprocal length).
+                let g = |k: usize| F32x16::gather(&vn[k], i, m);
+                let normal = |j: usize| V3::new(g(3 * j), g(3 * j + 1), g(3 * j + 2));
+                let v = normal(0) * b0 + normal(1) * b1 + normal(2) * b2;
+                let rcp = F32x16::splat(1.0) / v.length();
+                let fine = rcp.is_finite() & rcp.gt(F32x16::splat(0.0));
+                let zero = F32x16::splat(0.0);
+                let v = V3::select(fine, v * rcp, V3::new(zero, zero, zero));
+                let vanished = v.x.eq(zero) & v.y.eq(zero) & v.z.eq(zero);
+                V3::select(vanished, n, v)
+            }
+        };
         Some(ShapePointLanes {
             p: v0 * b0 + v1 * b1 + v2 * b2,
-            n: vertex(3),
+            n,
+            front,
             p_error: (v0.abs() * b0 + v1.abs() * b1 + v2.abs() * b2) * F32x16::splat(gamma(6)),
         })
     }

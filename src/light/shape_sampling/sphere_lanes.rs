@@ -165,6 +165,7 @@ impl SphereSampler {
             point: ShapePointLanes {
                 p,
                 n,
+                front: n,
                 p_error: splat3(p_error),
             },
             pdf_solid_angle,
