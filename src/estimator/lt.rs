@@ -30,8 +30,12 @@ use rayon::prelude::*;
 use super::{Estimator, Stats};
 use crate::error::Result;
 use crate::film::{Film, SplatList};
+use crate::geometry::Ray;
+use crate::geometry::packet::RayLanes;
 use crate::image::Image;
 use crate::material::TransportMode;
+use crate::math::Rgb;
+use crate::math::lanes::LANES;
 use crate::path::camera_connection::{self, CameraSplat};
 use crate::path::random_walk::{Step, Walk, WalkHook, random_walk};
 use crate::path::settings::PathSettings;
@@ -90,7 +94,7 @@ impl LightTracer {
         &self,
         scene: &Scene,
         sampler: &mut impl Sampler,
-        splats: &mut SplatList,
+        splats: &mut PendingSplats,
         counts: &mut BlockCounts,
     ) {
         let max_depth = self.settings.max_segments();
@@ -132,13 +136,13 @@ impl LightTracer {
         hook.counts.rays += rays;
     }
 
-    /// Casts `splat`'s shadow ray and keeps it if the camera sees its vertex; a value that
-    /// is NaN, infinite or negative is dropped and counted instead.
+    /// Queues `splat` for its shadow ray (it is kept if the camera sees its vertex); a value
+    /// that is NaN, infinite or negative is dropped and counted instead.
     fn record(
         &self,
         scene: &Scene,
         splat: &CameraSplat,
-        splats: &mut SplatList,
+        splats: &mut PendingSplats,
         counts: &mut BlockCounts,
     ) {
         if !splat.value.is_valid_radiance() {
@@ -146,9 +150,48 @@ impl LightTracer {
             return;
         }
         counts.rays += 1;
-        if !scene.geometry.occluded(&splat.shadow) {
-            splats.push(splat.raster, splat.value);
+        splats.push(scene, splat);
+    }
+}
+
+/// A block's splats, each waiting for its shadow ray until sixteen wait: they are then cast
+/// as one packet (`Geometry::occluded_lanes`: sixteen rays per triangle test on a small
+/// scene), and the visible ones join the block's list in the order they were made, so the
+/// list is the one casting them one by one would give.
+struct PendingSplats<'s> {
+    splats: &'s mut SplatList,
+    waiting: Vec<(Vec2, Rgb, Ray)>,
+}
+
+impl<'s> PendingSplats<'s> {
+    fn new(splats: &'s mut SplatList) -> Self {
+        PendingSplats {
+            splats,
+            waiting: Vec::with_capacity(LANES),
         }
+    }
+
+    fn push(&mut self, scene: &Scene, splat: &CameraSplat) {
+        self.waiting.push((splat.raster, splat.value, splat.shadow));
+        if self.waiting.len() == LANES {
+            self.settle(scene);
+        }
+    }
+
+    /// Casts the waiting splats' shadow rays and keeps the visible ones.
+    fn settle(&mut self, scene: &Scene) {
+        if self.waiting.is_empty() {
+            return;
+        }
+        let waiting = &self.waiting;
+        let (rays, m) = RayLanes::from_rays(waiting.len(), |k| Some(waiting[k].2));
+        let blocked = scene.geometry.occluded_lanes(&rays, m);
+        for (k, &(raster, value, _)) in waiting.iter().enumerate() {
+            if !blocked.get(k) {
+                self.splats.push(raster, value);
+            }
+        }
+        self.waiting.clear();
     }
 }
 
@@ -165,15 +208,15 @@ fn lens_sample(scene: &Scene, sampler: &mut impl Sampler) -> Vec2 {
 }
 
 /// Joins every vertex of a light walk to the camera (the walk's hook).
-struct CameraJoin<'t, 'o> {
+struct CameraJoin<'t, 'o, 's> {
     tracer: &'t LightTracer,
     scene: &'t Scene,
-    splats: &'o mut SplatList,
+    splats: &'o mut PendingSplats<'s>,
     counts: &'o mut BlockCounts,
     max_depth: u32,
 }
 
-impl<'a> WalkHook<'a> for CameraJoin<'_, '_> {
+impl<'a> WalkHook<'a> for CameraJoin<'_, '_, '_> {
     fn arrive(&mut self, v: &Vertex<'a>, walk: &Walk, sampler: &mut impl Sampler) -> Step {
         // Joining `v` to the camera makes a path of the emitted segment, the walk's
         // scatterings and the connection.
@@ -217,11 +260,13 @@ impl Estimator for LightTracer {
                 splats.clear();
                 let mut counts = BlockCounts::default();
                 let mut sampler = IndependentSampler::new(self.seed);
+                let mut pending = PendingSplats::new(splats);
                 let first = b as u64 * PATHS_PER_BLOCK;
                 for path in first..(first + PATHS_PER_BLOCK).min(n) {
                     sampler.start_light_path(path, STREAM_TAG, pass_index as u64);
-                    self.trace(scene, &mut sampler, splats, &mut counts);
+                    self.trace(scene, &mut sampler, &mut pending, &mut counts);
                 }
+                pending.settle(scene);
                 counts
             })
             .collect();

@@ -31,6 +31,32 @@ pub struct RayLanes {
 }
 
 impl RayLanes {
+    /// Up to sixteen rays in lanes: lane k holds `ray(k)` for k < `n` where it is Some;
+    /// with the mask of those lanes (others hold zeros).
+    #[inline]
+    pub fn from_rays(n: usize, mut ray: impl FnMut(usize) -> Option<Ray>) -> (RayLanes, Mask16) {
+        let mut lanes = [[0.0f32; LANES]; 7];
+        let mut m = Mask16::NONE;
+        for k in 0..n.min(LANES) {
+            if let Some(r) = ray(k) {
+                for (a, v) in lanes
+                    .iter_mut()
+                    .zip([r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.t_max])
+                {
+                    a[k] = v;
+                }
+                m.set(k, true);
+            }
+        }
+        let [ox, oy, oz, dx, dy, dz, t_max] = lanes.map(F32x16::from_array);
+        let rays = RayLanes {
+            o: V3::new(ox, oy, oz),
+            d: V3::new(dx, dy, dz),
+            t_max,
+        };
+        (rays, m)
+    }
+
     /// Lane `i` as a `Ray`.
     pub fn lane(&self, i: usize) -> Ray {
         let g = |v: F32x16| v.to_array()[i];

@@ -27,7 +27,7 @@ use crate::film::{Film, SplatList};
 use crate::geometry::Ray;
 use crate::geometry::packet::RayLanes;
 use crate::math::Rgb;
-use crate::math::lanes::{F32x16, LANES, Mask16, V3};
+use crate::math::lanes::{LANES, Mask16};
 use crate::path::connection::{self, Connection, Sampled, SubpathWeights};
 pub use crate::path::mis::Heuristic;
 use crate::path::settings::PathSettings;
@@ -367,29 +367,11 @@ impl<'a> ConnectionGroup<'a> {
 
     /// The entries whose shadow ray is blocked (counting each ray cast in `rays`).
     fn cast_shadows(&self, scene: &Scene, rays: &mut u64) -> Mask16 {
-        let mut lanes = [[0.0f32; LANES]; 7];
-        let mut m = Mask16::NONE;
-        for (k, (_, _, c)) in self.entries.iter().enumerate() {
-            if let Some(r) = &c.shadow {
-                for (a, v) in lanes
-                    .iter_mut()
-                    .zip([r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.t_max])
-                {
-                    a[k] = v;
-                }
-                m.set(k, true);
-            }
-        }
+        let (shadows, m) = RayLanes::from_rays(self.entries.len(), |k| self.entries[k].2.shadow);
         if m.none() {
             return Mask16::NONE;
         }
         *rays += m.count() as u64;
-        let [ox, oy, oz, dx, dy, dz, t_max] = lanes.map(F32x16::from_array);
-        let shadows = RayLanes {
-            o: V3::new(ox, oy, oz),
-            d: V3::new(dx, dy, dz),
-            t_max,
-        };
         scene.geometry.occluded_lanes(&shadows, m)
     }
 }
