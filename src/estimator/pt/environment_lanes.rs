@@ -5,7 +5,7 @@
 use glam::Vec3;
 
 use super::PathSample;
-use super::diffuse_lanes::power_heuristic_lanes;
+use super::next_event_lanes::power_heuristic_lanes;
 use super::path_lanes::{PathLanes, lane3, put3, with_lane};
 use super::shadow_queue::ShadowQueue;
 use crate::geometry::packet::RayLanes;

@@ -12,8 +12,8 @@ use std::borrow::Cow;
 use glam::{Vec2, Vec3};
 
 use super::PathSample;
-use super::diffuse_lanes::{NeeLanes, queue_light_sample};
 use super::hit_lanes::HitLanes;
+use super::next_event_lanes::{NeeLanes, queue_light_sample};
 use super::path_lanes::{PathLanes, lane, lane3, put3, with_lane};
 use super::shadow_queue::ShadowQueue;
 use super::walk_lanes::SampleLanes;
@@ -59,7 +59,9 @@ impl PathSample {
         // `Walk::scatter`'s sample).
         let mut f = zero3;
         let mut bsdf_pdf = zero;
-        let mut connectible = Mask16::NONE;
+        // Lanes where the scalar code adds a light contribution: a light sample at a vertex a
+        // connection may end at.
+        let mut adds = Mask16::NONE;
         let mut sampled = Mask16::NONE;
         let mut sample = SampleLanes {
             wi: zero3,
@@ -81,7 +83,7 @@ impl PathSample {
             // `Vertex::is_connectible`: next-event estimation only where a connection may
             // end.
             if bsdf.has_non_delta() && ls.ok.get(i) {
-                connectible.set(i, true);
+                adds.set(i, true);
                 let wi = lane3(&wi_light, i);
                 let fi = bsdf.eval(wo_i, wi, TransportMode::Radiance) * wi.z.abs();
                 put3(&mut f, i, channels(fi));
@@ -100,7 +102,7 @@ impl PathSample {
                 sample.eta = with_lane(sample.eta, i, s.eta);
             }
         }
-        queue_light_sample(lanes, hits, &ls, f, bsdf_pdf, connectible, shadows);
+        queue_light_sample(lanes, hits, &ls, f, bsdf_pdf, adds, shadows);
         (m & !sampled) | self.leave_lanes(lanes, hits, &frame, sampled, &sample, u_roulette)
     }
 }

@@ -28,6 +28,7 @@ mod general_lanes;
 mod hit_lanes;
 mod lane_scene;
 mod lane_share;
+mod next_event_lanes;
 mod path_lanes;
 mod shadow_queue;
 mod specular_lanes;

@@ -18,10 +18,10 @@ use glam::Vec2;
 
 use super::PathSample;
 use super::PathState;
-use super::diffuse_lanes::power_heuristic_lanes;
 use super::hit_lanes::HitLanes;
 use super::lane_scene::NO_LIGHT;
 use super::lane_share::Coverage;
+use super::next_event_lanes::power_heuristic_lanes;
 use super::path_lanes::PathLanes;
 use super::shadow_queue::ShadowQueue;
 use crate::camera::raster_in_pixel_lanes;
