@@ -184,7 +184,7 @@ mod tests {
             state
         };
         let pick = |k: u64| -> f32 {
-            if k % 4 == 0 {
+            if k.is_multiple_of(4) {
                 specials[(k / 4 % specials.len() as u64) as usize]
             } else {
                 // Any float of moderate exponent and either sign.
