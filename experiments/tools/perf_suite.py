@@ -15,6 +15,13 @@ scenes of NO_MITSUBA, which Mitsuba 3 cannot load). Writes
 OUT/README.md and OUT/perf.csv. The meshes two scenes need are written on first use
 (experiments/perf/meshes/, not committed: one has 330k triangles).
 
+With --smallvcm PATH (a SmallVCM build: docs/performance.md says how it was built), `bdpt`
+is also timed against SmallVCM's `bpt` on smallvcm-cbox, --repeats back-to-back pairs of
+`smallvcm -a bpt -s 2 -i 6` and `mltbench render smallvcm-cbox.xml -e bdpt --spp 6`: the same
+512 x 512 x 6 path pairs, compared by each process's user + system CPU seconds (scene
+loading and image writing included on both sides), so the ratio does not depend on how either
+spreads its work over the cores. Written to the table's notes and to perf.csv.
+
 --binary times another build (e.g. an older commit's, built with `git worktree` and its own
 CARGO_TARGET_DIR) on this checkout's scenes, for before/after tables; the Mitsuba column
 always times this checkout's build (crosscheck_mitsuba.py). --against OLD alternates the
@@ -28,6 +35,7 @@ Needs only the standard library (and a built `target/release/mltbench`).
 import argparse
 import csv
 import math
+import os
 import statistics
 import struct
 import subprocess
@@ -191,6 +199,43 @@ def mitsuba_ratio(python, scene, threads, tmp):
     ), None
 
 
+def child_cpu_seconds(cmd, env=None):
+    """Runs `cmd` to completion; (user + system CPU seconds of that process, error or None)."""
+    proc = subprocess.Popen(cmd, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, env=env)
+    # wait4 reports the rusage of this child alone (not of earlier children).
+    _, status, usage = os.wait4(proc.pid, 0)
+    stderr = proc.stderr.read().decode(errors="replace")
+    proc.stderr.close()
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode != 0:
+        lines = stderr.strip().splitlines()
+        return None, (lines[-1] if lines else f"exit code {proc.returncode}")
+    return usage.ru_utime + usage.ru_stime, None
+
+
+# The SmallVCM comparison: its scene 2 at its 512 x 512, six iterations (path pairs per pixel).
+SMALLVCM_SCENE = "experiments/perf/smallvcm-cbox.xml"
+SMALLVCM_ITERATIONS = 6
+
+
+def smallvcm_pair(binary, smallvcm, threads, tmp):
+    """CPU seconds of SmallVCM's bpt and of mltbench's bdpt on the same path pairs, run in
+    turn: ((smallvcm_s, mltbench_s), error)."""
+    env = dict(os.environ, OMP_NUM_THREADS=str(threads))
+    theirs, error = child_cpu_seconds(
+        [str(smallvcm), "-a", "bpt", "-s", "2", "-i", str(SMALLVCM_ITERATIONS),
+         "-o", str(Path(tmp) / "smallvcm.bmp")], env)
+    if theirs is None:
+        return None, f"smallvcm: {error}"
+    ours, error = child_cpu_seconds(
+        [str(binary), "render", str(REPO / SMALLVCM_SCENE), "-e", "bdpt",
+         "--spp", str(SMALLVCM_ITERATIONS), "--threads", str(threads),
+         "-o", str(Path(tmp) / "smallvcm-bdpt.exr")])
+    if ours is None:
+        return None, f"mltbench: {error}"
+    return (theirs, ours), None
+
+
 def main(argv):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--repeats", type=int, default=1, help="renders (and Mitsuba pairs) per cell; medians")
@@ -198,6 +243,8 @@ def main(argv):
     p.add_argument("--only", help="comma-separated scene names of the suite")
     p.add_argument("--estimators", help="comma-separated estimators (default all)")
     p.add_argument("--mitsuba", metavar="PYTHON", help="a Python with the mitsuba package")
+    p.add_argument("--smallvcm", type=Path, metavar="PATH",
+                   help="a SmallVCM binary: time bdpt against its bpt on smallvcm-cbox (CPU seconds)")
     p.add_argument("--out", type=Path, default=REPO / "results" / "perf")
     p.add_argument("--binary", type=Path, default=BINARY, help="the mltbench build to time")
     p.add_argument("--against", type=Path, metavar="OLD",
@@ -205,6 +252,9 @@ def main(argv):
     args = p.parse_args(argv)
     if args.against and not args.against.exists():
         print(f"error: --against {args.against} not found", file=sys.stderr)
+        return 2
+    if args.smallvcm and not args.smallvcm.exists():
+        print(f"error: --smallvcm {args.smallvcm} not found", file=sys.stderr)
         return 2
     if not args.binary.exists():
         print(f"error: {args.binary} not found: run `cargo build --release` first", file=sys.stderr)
@@ -266,6 +316,23 @@ def main(argv):
                     row["mitsuba_error"] = error
                 print(f"{name:14} mitsuba  " + (f"ratio {row['mitsuba_ratio']:.2f}" if "mitsuba_ratio" in row
                       else f"error: {error}"), file=sys.stderr)
+            if args.smallvcm and scene == SMALLVCM_SCENE:
+                pairs, error = [], None
+                for _ in range(args.repeats):
+                    pair, error = smallvcm_pair(args.binary, args.smallvcm, args.threads, tmp)
+                    if pair is None:
+                        break
+                    pairs.append(pair)
+                if pairs and error is None:
+                    row["smallvcm_cpu_s"] = statistics.median(p[0] for p in pairs)
+                    row["bdpt_cpu_s"] = statistics.median(p[1] for p in pairs)
+                    row["bdpt_vs_smallvcm"] = statistics.median(p[0] / p[1] for p in pairs)
+                    row["smallvcm_pairs"] = pairs
+                else:
+                    row["smallvcm_error"] = error
+                print(f"{name:14} smallvcm "
+                      + (f"bdpt / SmallVCM bpt per CPU-second {row['bdpt_vs_smallvcm']:.2f}"
+                         if "bdpt_vs_smallvcm" in row else f"error: {error}"), file=sys.stderr)
             rows.append(row)
     write_outputs(args, rows, estimators)
     return 0
@@ -297,7 +364,8 @@ def write_outputs(args, rows, estimators):
     if args.against:
         write_against(args, rows, labels)
     with (args.out / "perf.csv").open("w", newline="") as f:
-        fields = ["scene", "file"] + labels + ["mitsuba_mpaths", "pt_pair_mpaths", "mitsuba_ratio"]
+        fields = ["scene", "file"] + labels + ["mitsuba_mpaths", "pt_pair_mpaths", "mitsuba_ratio",
+                                               "smallvcm_cpu_s", "bdpt_cpu_s", "bdpt_vs_smallvcm"]
         w = csv.DictWriter(f, fieldnames=fields, extrasaction="ignore")
         w.writeheader()
         for r in rows:
@@ -308,6 +376,7 @@ def write_outputs(args, rows, estimators):
         "",
         f"`python3 experiments/tools/perf_suite.py --repeats {args.repeats}"
         + (" --mitsuba PYTHON" if args.mitsuba else "")
+        + (" --smallvcm PATH" if args.smallvcm else "")
         + f"`, {args.threads} threads, {time.strftime('%Y-%m-%d')}. Millions of samples per second "
         f"(medians of {args.repeats}; {units}): camera samples for pt and bdpt, light paths for "
         "lt and ppm, mutations for pssmlt (base=bdpt) and mmlt, their bootstrap included.",
@@ -335,7 +404,15 @@ def write_outputs(args, rows, estimators):
     if ratios:
         gmean = math.exp(sum(math.log(x) for x in ratios) / len(ratios))
         lines += ["", f"Geometric mean of pt / Mitsuba over {len(ratios)} scenes: {gmean:.2f}."]
+    for r in rows:
+        if "bdpt_vs_smallvcm" in r:
+            each = ", ".join(f"{a:.2f} / {b:.2f} s" for a, b in r["smallvcm_pairs"])
+            lines += ["", f"`bdpt` against SmallVCM's `bpt` on {r['scene']} ({SMALLVCM_ITERATIONS} "
+                      f"path pairs per pixel at 512 x 512, {args.threads} threads, {len(r['smallvcm_pairs'])} "
+                      f"pairs taken in turn; CPU seconds SmallVCM / mltbench: {each}): "
+                      f"**{r['bdpt_vs_smallvcm']:.2f}×** SmallVCM's path pairs per CPU-second (median)."]
     errors = [(r["scene"], k, r[k + "_error"]) for r in rows for k in labels if r.get(k + "_error")]
+    errors += [(r["scene"], "smallvcm", r["smallvcm_error"]) for r in rows if r.get("smallvcm_error")]
     errors += [(r["scene"], "mitsuba", r["mitsuba_error"]) for r in rows if r.get("mitsuba_error")]
     if errors:
         lines += ["", "Errors:", ""] + [f"- {s}, {k}: {e}" for s, k, e in errors]
