@@ -8,11 +8,11 @@ use indicatif::ProgressBar;
 use mltbench::experiment::runner::read_rows;
 use mltbench::experiment::{self, Experiment, RunOptions};
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mltbench-exp-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+mod scratch_support;
+use scratch_support::ScratchDir;
+
+fn temp_dir(name: &str) -> ScratchDir {
+    ScratchDir::new(&format!("exp-{name}"))
 }
 
 fn scene_path() -> PathBuf {

@@ -18,6 +18,8 @@
 //! level for an overall significance of 10⁻³ over the `CHI2_CASES` cases of this file.
 
 mod chi2_support;
+mod scratch_support;
+use scratch_support::ScratchDir;
 
 use std::path::PathBuf;
 
@@ -1449,11 +1451,8 @@ fn envmap_matches_mitsuba_reference_values() {
     }
 }
 
-fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mltbench-lights-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn scratch(test: &str) -> ScratchDir {
+    ScratchDir::new(&format!("lights-{test}"))
 }
 
 fn envmap_scene(path: PathBuf) -> SceneDescription {

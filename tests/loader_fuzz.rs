@@ -69,7 +69,8 @@ fn check_mutant(path: &Path) -> Result<bool, String> {
 
 #[test]
 fn damaged_scenes_load_or_fail_cleanly() {
-    let scratch = scratch("fuzz").join("mutant.xml");
+    let folder = scratch("fuzz");
+    let scratch = folder.join("mutant.xml");
     let scenes = shipped_files("experiments/scenes", "xml");
     let (loaded, total) = check_mutants(&scenes, MUTANTS, 0xf022_5eed, &scratch, check_mutant);
     println!("{loaded} of {total} mutants loaded and rendered; the others were refused");

@@ -9,11 +9,12 @@ use mltbench::scene::TriangleMesh;
 use mltbench::scene::obj::read_obj;
 use mltbench::scene::ply::read_ply;
 
+mod scratch_support;
+use scratch_support::ScratchDir;
+
 /// A fresh directory for one test's fixture files.
-fn temp_dir(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mltbench-mesh-{}-{test}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn temp_dir(test: &str) -> ScratchDir {
+    ScratchDir::new(&format!("mesh-{test}"))
 }
 
 fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
@@ -321,7 +322,7 @@ fn readers_refuse_directories_and_fifos_without_opening_them() {
         .arg(&fifo)
         .status()
         .is_ok_and(|s| s.success());
-    let mut inputs = vec![(dir.clone(), "is a directory")];
+    let mut inputs = vec![(dir.to_path_buf(), "is a directory")];
     if has_fifo {
         inputs.push((fifo, "not a regular file"));
     }

@@ -235,6 +235,7 @@ fn assert_floor_under_the_cbox_light_as_obj(name: &str, normals_and_faces: &str)
         &dir.join("scene.xml"),
         None,
     );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// A closed box of diffuse walls (reflectance 0.6) lit by a small ceiling light, all moved

@@ -9,14 +9,15 @@ use mltbench::image::Image;
 use mltbench::render::{Budget, render};
 use mltbench::scene::{Scene, mitsuba};
 
+mod scratch_support;
+use scratch_support::ScratchDir;
+
 fn scenes_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("experiments/scenes")
 }
 
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mltbench-render-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+fn temp_dir(name: &str) -> ScratchDir {
+    ScratchDir::new(&format!("render-{name}"))
 }
 
 /// Loads a scene file with its `res` default set to `res`.

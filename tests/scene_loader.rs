@@ -2157,7 +2157,7 @@ fn inputs_that_are_not_regular_files_are_errors() {
         "<emitter type=\"envmap\">\n<string name=\"filename\" value=\"pipe\"/></emitter>",
     ] {
         let text = with_sphere(body);
-        let scene_dir = dir.clone();
+        let scene_dir = dir.to_path_buf();
         let loaded = within_seconds(move || load_written(&scene_dir, &text).map(|_| ()));
         let message = loaded.unwrap_err().to_string();
         assert!(message.contains("not a regular file"), "{message}");

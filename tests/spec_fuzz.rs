@@ -64,7 +64,8 @@ fn check_mutant(path: &Path) -> Result<bool, String> {
 
 #[test]
 fn damaged_specs_parse_or_fail_cleanly() {
-    let scratch = scratch("spec-fuzz").join("mutant.toml");
+    let folder = scratch("spec-fuzz");
+    let scratch = folder.join("mutant.toml");
     let specs = shipped_files("experiments", "toml");
     let (parsed, total) = check_mutants(&specs, MUTANTS, 0x5bec_f022, &scratch, check_mutant);
     println!("{parsed} of {total} mutants parsed; the others were refused");

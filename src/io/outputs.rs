@@ -72,6 +72,7 @@ mod tests {
         let dir = temp_dir("sidecars");
         let sidecars = check_outputs(&dir.join("a.exr"), &["json", "png"]).unwrap();
         assert_eq!(sidecars, vec![dir.join("a.json"), dir.join("a.png")]);
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
@@ -84,6 +85,7 @@ mod tests {
                 "{name}: {err}"
             );
         }
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
@@ -112,6 +114,7 @@ mod tests {
         let outputs = [dir.join("out.exr"), dir.join("out.png")];
         std::fs::write(&outputs[0], "old").unwrap();
         check_not_inputs(outputs.iter().map(PathBuf::as_path), &inputs).unwrap();
+        std::fs::remove_dir_all(&dir).ok();
     }
 
     #[test]
@@ -120,5 +123,6 @@ mod tests {
         std::fs::create_dir_all(dir.join("b.json")).unwrap();
         let err = check_outputs(&dir.join("b.exr"), &["json"]).unwrap_err();
         assert!(err.to_string().contains("b.json"), "{err}");
+        std::fs::remove_dir_all(&dir).ok();
     }
 }

@@ -7,12 +7,14 @@ use mltbench::Error;
 use mltbench::scene::SceneDescription;
 use mltbench::scene::mitsuba::{load_file, load_str};
 
-/// A fresh, empty folder for one test (unique per process and test name).
-pub fn scratch(test: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("mltbench-loader-{}-{test}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("create scratch folder");
-    dir
+#[path = "../scratch_support/mod.rs"]
+mod scratch_support;
+pub use scratch_support::ScratchDir;
+
+/// A fresh, empty folder for one test (unique per process and test name), removed when the
+/// test is done with it.
+pub fn scratch(test: &str) -> ScratchDir {
+    ScratchDir::new(&format!("loader-{test}"))
 }
 
 /// Writes `text` to `dir/name` (creating sub-folders) and returns the path.
