@@ -236,6 +236,20 @@ def smallvcm_pair(binary, smallvcm, threads, tmp):
     return (theirs, ours), None
 
 
+def repeated(repeats, measure):
+    """`measure()` (a (result, error) pair) `repeats` times: (results, None), or (results so
+    far, the first error)."""
+    results = []
+    for _ in range(repeats):
+        result, error = measure()
+        if result is None:
+            return results, error
+        results.append(result)
+    if not results:
+        return results, "no repeats"
+    return results, None
+
+
 def main(argv):
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--repeats", type=int, default=1, help="renders (and Mitsuba pairs) per cell; medians")
@@ -302,13 +316,8 @@ def main(argv):
                 row["mitsuba_skipped"] = NO_MITSUBA[name]
                 print(f"{name:14} mitsuba  skipped: {NO_MITSUBA[name]}", file=sys.stderr)
             elif args.mitsuba:
-                pairs, error = [], None
-                for _ in range(args.repeats):
-                    pair, error = mitsuba_ratio(args.mitsuba, scene, args.threads, tmp)
-                    if pair is None:
-                        break
-                    pairs.append(pair)
-                if pairs and error is None:
+                pairs, error = repeated(args.repeats, lambda: mitsuba_ratio(args.mitsuba, scene, args.threads, tmp))
+                if error is None:
                     row["mitsuba_ratio"] = statistics.median(p[0] for p in pairs)
                     row["mitsuba_mpaths"] = statistics.median(p[2] for p in pairs)
                     row["pt_pair_mpaths"] = statistics.median(p[1] for p in pairs)
@@ -317,13 +326,9 @@ def main(argv):
                 print(f"{name:14} mitsuba  " + (f"ratio {row['mitsuba_ratio']:.2f}" if "mitsuba_ratio" in row
                       else f"error: {error}"), file=sys.stderr)
             if args.smallvcm and scene == SMALLVCM_SCENE:
-                pairs, error = [], None
-                for _ in range(args.repeats):
-                    pair, error = smallvcm_pair(args.binary, args.smallvcm, args.threads, tmp)
-                    if pair is None:
-                        break
-                    pairs.append(pair)
-                if pairs and error is None:
+                pairs, error = repeated(
+                    args.repeats, lambda: smallvcm_pair(args.binary, args.smallvcm, args.threads, tmp))
+                if error is None:
                     row["smallvcm_cpu_s"] = statistics.median(p[0] for p in pairs)
                     row["bdpt_cpu_s"] = statistics.median(p[1] for p in pairs)
                     row["bdpt_vs_smallvcm"] = statistics.median(p[0] / p[1] for p in pairs)
