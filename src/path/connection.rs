@@ -48,6 +48,26 @@ pub struct Connection<'a> {
     pub densities: EndpointDensities,
 }
 
+impl<'a> Connection<'a> {
+    /// What the weight of this connection's strategy reads from it (`weight`).
+    pub fn ends(&self) -> ConnectionEnds<'_, 'a> {
+        ConnectionEnds {
+            sampled: self.sampled.as_ref(),
+            densities: self.densities,
+        }
+    }
+}
+
+/// The parts of a connection its strategy's weight depends on: the endpoint it sampled
+/// and the densities its evaluation gave. A caller that keeps connections waiting can
+/// keep the sampled endpoints apart (most strategies have none, and a vertex is most of
+/// a connection's size) and hand them back here.
+#[derive(Clone, Copy)]
+pub struct ConnectionEnds<'c, 'a> {
+    pub sampled: Option<&'c Sampled<'a>>,
+    pub densities: EndpointDensities,
+}
+
 /// The solid-angle densities of the BSDFs at a connection's endpoints, from the same
 /// evaluation as their f (`Bsdf::eval_with_pdfs`): at z(t−1), of leaving towards y(s−1)
 /// having come from z(t−2), and the reverse; at y(s−1), towards z(t−1) from y(s−2), and the
@@ -278,13 +298,13 @@ fn joint(
     scene: &Scene,
     light_path: &[Vertex],
     camera_path: &[Vertex],
-    connection: &Connection,
+    ends: ConnectionEnds,
     s: usize,
     t: usize,
     heuristic: Heuristic,
     hide_emitters: bool,
 ) -> (Joint, StrategyRules) {
-    let sampled = connection.sampled.as_ref();
+    let sampled = ends.sampled;
     // The strategy's endpoints as vertices (the sampled one where there is one).
     let light_end = |i: usize| match sampled {
         Some(Sampled {
@@ -312,7 +332,7 @@ fn joint(
     let EndpointDensities {
         camera: at_pt,
         light: at_qs,
-    } = connection.densities;
+    } = ends.densities;
     let camera = [
         Some(PathDensity {
             from_light: match (qs, at_qs) {
@@ -373,7 +393,7 @@ pub fn weight(
     scene: &Scene,
     light_path: &[Vertex],
     camera_path: &[Vertex],
-    connection: &Connection,
+    ends: ConnectionEnds,
     s: usize,
     t: usize,
     heuristic: Heuristic,
@@ -384,7 +404,7 @@ pub fn weight(
         scene,
         light_path,
         camera_path,
-        connection,
+        ends,
         s,
         t,
         heuristic,

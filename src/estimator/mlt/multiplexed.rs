@@ -187,7 +187,7 @@ impl PathTarget for MultiplexedTarget {
             scene,
             light_path,
             camera_path,
-            &c,
+            c.ends(),
             s,
             t,
             self.mis,
