@@ -764,39 +764,46 @@ fn the_wavefront_renders_the_scalar_images_bit_for_bit() {
         )),
         vec![],
     ));
-    // 6 cubes (72 triangles): more than a small scene, cast through the tree; a glass
-    // sphere and a diffuse disk among them (analytic hits beside the tree's triangles).
-    let cubes: String = (0..6)
-        .map(|i| {
-            format!(
-                r#"<shape type="cube"><transform name="to_world"><scale value="0.2"/>
-                    <translate x="{}" y="-0.7" z="{}"/></transform>
-                    <bsdf type="diffuse"><rgb name="reflectance" value="0.7"/></bsdf></shape>"#,
-                -0.6 + 0.25 * i as f32,
-                -0.5 + 0.1 * i as f32
-            )
-        })
-        .collect();
-    cases.push((
-        "cubes in a box (a tree)".into(),
-        scene(&format!(
-            r#"<scene version="3.0.0">
-                {camera}
-                {enclosure}
-                {CBOX_LIGHT_RECTANGLE}<emitter type="area"><rgb name="radiance" value="5"/></emitter></shape>
-                {cubes}
-                <shape type="sphere"><point name="center" x="0.3" y="-0.2" z="-2.4"/>
-                    <float name="radius" value="0.25"/>
-                    <bsdf type="dielectric"><float name="int_ior" value="1.5"/></bsdf></shape>
-                <shape type="disk"><transform name="to_world"><scale value="0.3"/>
-                    <rotate y="1" angle="20"/><translate x="-0.4" y="0.1" z="-2.8"/></transform>
-                    <bsdf type="diffuse"><rgb name="reflectance" value="0.3, 0.6, 0.2"/></bsdf></shape>
-            </scene>"#,
-            camera = camera(),
-            enclosure = enclosure("cube", "0.6", "0.1"),
-        )),
-        vec![],
-    ));
+    // Cubes (12 triangles each) in the enclosure (12) with the light (2): more than a
+    // small scene, cast through the tree; a glass sphere and a diffuse disk among them
+    // (analytic hits beside the tree's triangles). With 6 cubes (86 triangles) the lanes
+    // test full packets against every triangle and the scalar code walks the tree, which
+    // must keep the same triangle wherever their edges meet (equal t); with 10 (134, more
+    // than `PACKET_LIMIT`) the lanes walk the tree one ray at a time too.
+    for count in [6, 10] {
+        let cubes: String = (0..count)
+            .map(|i| {
+                format!(
+                    r#"<shape type="cube"><transform name="to_world"><scale value="0.2"/>
+                        <translate x="{}" y="{}" z="{}"/></transform>
+                        <bsdf type="diffuse"><rgb name="reflectance" value="0.7"/></bsdf></shape>"#,
+                    -0.6 + 0.25 * (i % 6) as f32,
+                    -0.7 + 0.5 * (i / 6) as f32,
+                    -0.5 + 0.1 * (i % 6) as f32
+                )
+            })
+            .collect();
+        cases.push((
+            format!("{count} cubes in a box (a tree)"),
+            scene(&format!(
+                r#"<scene version="3.0.0">
+                    {camera}
+                    {enclosure}
+                    {CBOX_LIGHT_RECTANGLE}<emitter type="area"><rgb name="radiance" value="5"/></emitter></shape>
+                    {cubes}
+                    <shape type="sphere"><point name="center" x="0.3" y="-0.2" z="-2.4"/>
+                        <float name="radius" value="0.25"/>
+                        <bsdf type="dielectric"><float name="int_ior" value="1.5"/></bsdf></shape>
+                    <shape type="disk"><transform name="to_world"><scale value="0.3"/>
+                        <rotate y="1" angle="20"/><translate x="-0.4" y="0.1" z="-2.8"/></transform>
+                        <bsdf type="diffuse"><rgb name="reflectance" value="0.3, 0.6, 0.2"/></bsdf></shape>
+                </scene>"#,
+                camera = camera(),
+                enclosure = enclosure("cube", "0.6", "0.1"),
+            )),
+            vec![],
+        ));
+    }
     for (name, scene, params) in &cases {
         let run = |wavefront: &str| {
             let mut all = params.clone();

@@ -31,7 +31,7 @@ pub use stream::IN_FLIGHT;
 use super::cwbvh;
 use super::flat::{FLAT_LIMIT, FlatTriangles, LANE_LEAVES_LIMIT};
 use super::offset::gamma;
-use super::packet::PacketTriangles;
+use super::packet::{PACKET_LIMIT, PacketTriangles};
 use super::triangle::{TriangleHit, TriangleRay, TriangleRecord};
 
 /// Binary BVH settings for `n` triangles: obvhs's `fast_build` preset (PLOC with a short
@@ -156,7 +156,8 @@ pub struct TriangleBvh {
     /// otherwise the tree's traversal tests each node's hit leaf triangles in these lanes
     /// (empty beyond `LANE_LEAVES_LIMIT` triangles: one by one there).
     lanes: FlatTriangles,
-    /// The same records for sixteen rays at a time (`packet.rs`), also only when flat.
+    /// The same records for sixteen rays at a time (`packet.rs`): on flat scenes and trees
+    /// of at most `PACKET_LIMIT` triangles.
     packet: PacketTriangles,
 }
 
@@ -218,14 +219,17 @@ impl TriangleBvh {
         });
         // A flat scene keeps no nodes: `is_flat` is the emptiness test the tree's queries make
         // anyway.
-        let (nodes, packet) = if records.len() <= flat_limit {
-            let packet = PacketTriangles::new(&records);
-            (Vec::new(), packet)
+        let nodes = if records.len() <= flat_limit {
+            Vec::new()
         } else {
-            (
-                collect_large(wide.nodes.par_iter().copied()),
-                PacketTriangles::default(),
-            )
+            collect_large(wide.nodes.par_iter().copied())
+        };
+        // Sixteen-ray queries test every triangle in lanes on a flat scene, and on a small
+        // tree when enough lanes are active (`Geometry::packet_pays`).
+        let packet = if nodes.is_empty() || records.len() <= PACKET_LIMIT {
+            PacketTriangles::new(&records)
+        } else {
+            PacketTriangles::default()
         };
         TriangleBvh {
             nodes,
@@ -300,6 +304,13 @@ impl TriangleBvh {
     #[inline(always)]
     pub fn is_flat(&self) -> bool {
         self.nodes.is_empty()
+    }
+
+    /// True when sixteen-ray queries test every triangle in lanes (`PacketTriangles`):
+    /// flat scenes and trees of at most `PACKET_LIMIT` triangles.
+    #[inline(always)]
+    pub fn has_packet(&self) -> bool {
+        self.is_flat() || !self.packet.is_empty()
     }
 
     /// Closest triangle with 0 < t < t_max: (record index, its hit data).
@@ -488,15 +499,22 @@ impl Visitor for Closest<'_> {
     #[inline(always)]
     fn visit(&mut self, base: u32, bits: u32, t_max: &mut f32) -> bool {
         let (bvh, best) = (self.bvh, &mut self.best);
+        // The node's lowest record could tie with the best hit so far: test up to just
+        // beyond it (`tie_limit`), and let `replaces` keep the lower index.
+        let first = base + bits.trailing_zeros();
+        let mut limit = tie_limit(*best, first, *t_max);
         bvh.lanes.hits_of(
             &bvh.records,
             &self.ray.tri,
             base,
             bits,
-            t_max,
-            |id, h, t_max| {
-                *t_max = h.t;
+            &mut limit,
+            |id, h, limit| {
+                if !replaces(*best, id as u32, h.t) {
+                    return false;
+                }
                 *best = Some((id as u32, h));
+                *limit = tie_limit(*best, id as u32 + 1, h.t);
                 // The surface data of the closest hit will be read from these: start
                 // fetching them while traversal goes on.
                 if let Some(n) = &bvh.normals {
@@ -507,7 +525,35 @@ impl Visitor for Closest<'_> {
                 }
                 false
             },
-        )
+        );
+        if let Some((_, h)) = best {
+            *t_max = h.t;
+        }
+        false
+    }
+}
+
+/// The closest-hit rule of every triangle query: a hit replaces the best one so far when
+/// it is nearer, or exactly as near with a lower record index. The flat and sixteen-ray
+/// tests meet the records in index order and keep the first of equal t; the tree meets
+/// them in traversal order, so it needs the index to keep the same one.
+#[inline(always)]
+pub(crate) fn replaces(best: Option<(u32, TriangleHit)>, id: u32, t: f32) -> bool {
+    match best {
+        None => true,
+        Some((best_id, h)) => t < h.t || (t == h.t && id < best_id),
+    }
+}
+
+/// The segment end to test records from index `first` on against: `t_max` (the best t, or
+/// the ray's end before any hit), or two floats beyond the best t when `first` precedes the
+/// best record, so that an exact tie passes the triangle test's scaled pre-check
+/// (`triangle::hit_from`: T < t_max·det, rounded) and reaches `replaces`.
+#[inline(always)]
+pub(crate) fn tie_limit(best: Option<(u32, TriangleHit)>, first: u32, t_max: f32) -> f32 {
+    match best {
+        Some((best_id, h)) if first < best_id => h.t.next_up().next_up(),
+        _ => t_max,
     }
 }
 

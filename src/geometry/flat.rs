@@ -15,8 +15,8 @@
 //! division and the t < t_max check, `triangle::hit_from`). The others (zero edge functions,
 //! decided in f64; T too close to 0 for its sign to be certain) go through
 //! `triangle::intersect` itself. So this path reports a hit exactly when the per-triangle
-//! test does, with the same t and edge functions; only the choice between hits at exactly
-//! equal t can differ from the tree's (here the lowest record index wins).
+//! test does, with the same t and edge functions. Among hits at exactly equal t the lowest
+//! record index wins, here and in the tree (`bvh::replaces`).
 //!
 //! Larger scenes (up to `LANE_LEAVES_LIMIT` triangles) keep the same chunks beside their
 //! tree: traversal tests each node's hit leaf triangles (up to 24, contiguous in record
@@ -632,15 +632,69 @@ mod tests {
             };
             let r = TraversalRay::new(o, d);
             let t_max = [f32::INFINITY, 0.3][(i % 2) as usize];
-            // Same distance; the triangle may differ only between hits at equal t.
-            let a = tree.closest(&r, t_max).map(|(_, h)| h.t.to_bits());
-            let b = flat.closest(&r, t_max).map(|(_, h)| h.t.to_bits());
+            // The same triangle at the same distance (ties included: `replaces`).
+            let a = tree.closest(&r, t_max).map(|(id, h)| (id, h.t.to_bits()));
+            let b = flat.closest(&r, t_max).map(|(id, h)| (id, h.t.to_bits()));
             assert_eq!(a, b, "ray {i}");
             assert_eq!(tree.any(&r, t_max), flat.any(&r, t_max), "ray {i}");
             hits += a.is_some() as u32;
         }
         // Half the rays are long enough to hit a wall (the box is open at the front).
         assert!(hits > 40_000, "{hits} hits");
+    }
+
+    /// A floor of 30 × 30 unit squares, two triangles each, hit straight down on the
+    /// edges, diagonals and corners the triangles share: the arithmetic is exact there, so
+    /// two to six triangles report the same t. The tree meets them in traversal order and
+    /// must keep the one the flat scan keeps (the lowest record index), so that both kinds
+    /// of query report the same triangle.
+    #[test]
+    fn the_tree_keeps_the_flat_scans_triangle_among_exact_ties() {
+        use crate::geometry::bvh::{TraversalRay, TriangleBvh, TriangleList};
+        const N: u32 = 30;
+        let corner = |i: u32, j: u32| Vec3::new(i as f32, 0.0, j as f32);
+        let mut vertices = Vec::new();
+        for j in 0..N {
+            for i in 0..N {
+                let (a, b) = (corner(i, j), corner(i + 1, j));
+                let (c, d) = (corner(i, j + 1), corner(i + 1, j + 1));
+                vertices.push([a, b, d]);
+                vertices.push([a, d, c]);
+            }
+        }
+        let ids: Vec<[u32; 2]> = (0..vertices.len() as u32).map(|i| [0, i]).collect();
+        let list = TriangleList {
+            vertices: &vertices,
+            ids: &ids,
+        };
+        let tree = TriangleBvh::build_with_flat_limit(&list, 0);
+        let flat = TriangleBvh::build_with_flat_limit(&list, usize::MAX);
+        assert!(!tree.is_flat() && flat.is_flat());
+        let mut rays = Vec::new();
+        for j in 1..N {
+            for i in 1..N {
+                // A corner, the middles of two shared edges, and a point of the diagonal.
+                for (x, z) in [(0.0, 0.0), (0.5, 0.0), (0.0, 0.5), (0.25, 0.25)] {
+                    let o = Vec3::new(i as f32 + x, 1.0, j as f32 + z);
+                    rays.push(TraversalRay::new(o, Vec3::NEG_Y));
+                }
+            }
+        }
+        let found = |hit: Option<(u32, TriangleHit)>| hit.map(|(id, h)| (id, h.t.to_bits()));
+        let mut streamed = vec![None; rays.len()];
+        let ends = vec![f32::INFINITY; rays.len()];
+        tree.closest_stream(&rays, &ends, |k, hit| streamed[k] = found(hit));
+        for (r, streamed) in rays.iter().zip(streamed) {
+            let want = found(flat.closest(r, f32::INFINITY));
+            assert!(want.is_some(), "every ray hits the floor");
+            assert_eq!(
+                found(tree.closest(r, f32::INFINITY)),
+                want,
+                "ray down from {}",
+                r.o
+            );
+            assert_eq!(streamed, want, "streamed ray down from {}", r.o);
+        }
     }
 
     #[test]

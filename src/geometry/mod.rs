@@ -10,7 +10,8 @@
 //!   (`Geometry::intersect_stream`), for scenes too large for the cache.
 //! - `cwbvh.rs`: collapsing obvhs's binary BVH into the 8-wide one.
 //! - `flat.rs`: small scenes answered without the tree, sixteen triangles per test.
-//! - `packet.rs`: sixteen rays at a time on those small scenes, one triangle per test.
+//! - `packet.rs`: sixteen rays at a time on those small scenes (and on trees of at most
+//!   `PACKET_LIMIT` triangles when enough lanes are active), one triangle per test.
 //! - `triangle.rs`: the watertight ray/triangle test and the hit point's error bound.
 //! - `sphere.rs`, `disk.rs`: analytic shapes, tested one by one in f64.
 //! - `offset.rs`: error bounds and robust origins for rays leaving a surface.

@@ -13,7 +13,10 @@
 //! The analytic shapes of a small scene come first, as in the per-ray queries: spheres and
 //! disks in f64 lanes (`Sphere::intersect_lanes`, `Disk::intersect_lanes`: the same
 //! operations in the same order); the triangles are then tested within what is left of each segment.
-//! Scenes with a tree are answered one lane at a time by the per-ray queries.
+//! Larger scenes are answered one lane at a time through the tree by the per-ray queries;
+//! trees of at most `PACKET_LIMIT` triangles keep a packet too and use it when enough lanes
+//! are active. The tree keeps the same triangle as the packet among hits at equal t (the
+//! lowest record index, `bvh::replaces`), so either way gives the same bits.
 
 use super::bvh::TraversalRay;
 use super::offset::gamma;
@@ -21,6 +24,15 @@ use super::sphere;
 use super::triangle::{self, BoundArithmetic, TriangleHit, TriangleRay, TriangleRecord};
 use super::{ClosestHit, Geometry, Hit, Ray, ScaledRay};
 use crate::math::lanes::{F32x16, F64x8, LANES, Mask8, Mask16, U32x16, V3};
+
+/// Trees of at most this many triangles keep a packet (`PacketTriangles`) beside the tree
+/// for the sixteen-ray queries. A packet tests every triangle against all sixteen lanes,
+/// whatever the lanes; the tree traces the active lanes one by one. Measured with `pt`
+/// (full packets) on a rippled mesh of 54 to 166 triangles (`experiments/perf/water.xml`'s
+/// scene, `docs/performance.md`): the packet is faster up to about 120 triangles, so a
+/// traversal costs about as much as testing 120/16 ≈ 7 triangles in a packet, and
+/// `Geometry::packet_pays` asks for enough active lanes by that rate.
+pub const PACKET_LIMIT: usize = 112;
 
 /// Sixteen rays: origins, directions (need not be unit length) and segment ends.
 #[derive(Clone, Copy, Debug)]
@@ -98,6 +110,10 @@ pub struct PacketTriangles {
 }
 
 impl PacketTriangles {
+    pub fn is_empty(&self) -> bool {
+        self.triangles.is_empty()
+    }
+
     pub fn new(records: &[TriangleRecord]) -> PacketTriangles {
         let triangles = records
             .iter()
@@ -617,7 +633,7 @@ impl Geometry {
     /// triangle and sphere test on a small scene (`packet.rs`), one ray at a time on a
     /// scene with a tree.
     pub fn closest_hits_lanes(&self, rays: &RayLanes, m: Mask16, out: &mut ClosestLanes) {
-        if !self.bvh.is_flat() {
+        if !self.packet_pays(m) {
             self.closest_hits_one_by_one(rays, m, out);
             return;
         }
@@ -946,7 +962,7 @@ impl Geometry {
         if m.none() {
             return blocked;
         }
-        if !self.bvh.is_flat() {
+        if !self.packet_pays(m) {
             // The tree one ray at a time, for what the analytic shapes left.
             let scaled = scaled.lanes();
             let t_max = scaled.map(|s| s.t_max);
@@ -968,6 +984,17 @@ impl Geometry {
                 .bvh
                 .packet()
                 .any(self.bvh.records(), &tri, tri_ray, scaled.t_max, m)
+    }
+
+    /// Whether the lanes of `m` are tested against every triangle in lanes rather than
+    /// one by one through the tree: always on a flat scene; on a tree with packets, when
+    /// enough lanes are active for the packet's cost (one vector test per triangle,
+    /// whatever the lanes) to beat that many traversals.
+    #[inline(always)]
+    fn packet_pays(&self, m: Mask16) -> bool {
+        self.bvh.is_flat()
+            || (self.bvh.has_packet()
+                && m.count() as usize * PACKET_LIMIT >= LANES * self.bvh.records().len())
     }
 
     fn has_analytic_shapes(&self) -> bool {

@@ -16,6 +16,7 @@ use glam::{UVec2, uvec2};
 
 use super::{
     FIXED_STACK, FixedStack, TraversalRay, TraversalStack, TriangleBvh, node_hitmask, prefetch,
+    replaces, tie_limit,
 };
 use crate::geometry::triangle::{self, TriangleHit};
 
@@ -105,7 +106,10 @@ impl TriangleBvh {
             let bit = s.tri_group.y.trailing_zeros();
             s.tri_group.y &= s.tri_group.y - 1;
             let id = s.tri_group.x + bit;
-            if let Some(h) = triangle::intersect(&self.records[id as usize], &ray.tri, s.t_max) {
+            let limit = tie_limit(s.best, id, s.t_max);
+            if let Some(h) = triangle::intersect(&self.records[id as usize], &ray.tri, limit)
+                && replaces(s.best, id, h.t)
+            {
                 s.t_max = h.t;
                 s.best = Some((id, h));
                 // As in `closest`: start fetching the hit's surface data.
