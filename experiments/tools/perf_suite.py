@@ -22,6 +22,10 @@ is also timed against SmallVCM's `bpt` on smallvcm-cbox, --repeats back-to-back 
 loading and image writing included on both sides), so the ratio does not depend on how either
 spreads its work over the cores. Written to the table's notes and to perf.csv.
 
+With --bitterli DIR (the folder of Bitterli's scenes, e.g. ../shared/scenes/bitterli), the
+three scenes there are timed too, at a quarter of their width and height (`BITTERLI`): scenes the
+suite was not written for. Their pt / Mitsuba ratios get a geometric mean of their own.
+
 --binary times another build (e.g. an older commit's, built with `git worktree` and its own
 CARGO_TARGET_DIR) on this checkout's scenes, for before/after tables; the Mitsuba column
 always times this checkout's build (crosscheck_mitsuba.py). --against OLD alternates the
@@ -64,6 +68,15 @@ SUITE = [
     ("point", "experiments/scenes/cbox-point.xml", "point light"),
     ("smallvcm-cbox", "experiments/perf/smallvcm-cbox.xml",
      "SmallVCM's point-light box (its -s 2): bdpt against smallvcm -a bpt"),
+]
+
+# Bitterli's scenes (`--bitterli DIR`, DIR holding veach-mis/, veach-bidir/, cornell-box/,
+# each with scene.xml): scenes the suite was not written for, rendered at a quarter of their
+# width and height to keep each render to seconds. Reported beside the suite, not in its mean.
+BITTERLI = [
+    ("veach-mis", "sphere lights, rough conductor plates, 52 triangles", ["res_x=320", "res_y=180"]),
+    ("veach-bidir", "lamp in a shade, glass egg, 11.5k triangles", ["res_x=256", "res_y=256"]),
+    ("cornell-box", "the classic box, twosided walls, 36 triangles", ["res_x=256", "res_y=256"]),
 ]
 
 # Scenes Mitsuba 3 cannot load, and why: no pt / Mitsuba ratio for them.
@@ -164,10 +177,15 @@ def ensure_meshes():
 # ---------------------------------------------------------------- runs
 
 
-def render_rate(binary, scene, args, spp, threads, tmp):
+def define_args(defines):
+    """`-D NAME=VALUE` arguments (both renderers' command lines take them)."""
+    return [a for d in defines for a in ("-D", d)]
+
+
+def render_rate(binary, scene, args, spp, threads, tmp, defines=()):
     """Samples per second from one `mltbench render`, or an error message."""
     out = Path(tmp) / "perf.exr"
-    cmd = [str(binary), "render", str(REPO / scene), *args, "--spp", str(spp)]
+    cmd = [str(binary), "render", str(REPO / scene), *args, *define_args(defines), "--spp", str(spp)]
     cmd += ["--threads", str(threads), "-o", str(out)]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0:
@@ -180,11 +198,12 @@ def render_rate(binary, scene, args, spp, threads, tmp):
     return None, "no summary line in mltbench's output"
 
 
-def mitsuba_ratio(python, scene, threads, tmp):
+def mitsuba_ratio(python, scene, threads, tmp, defines=()):
     """mltbench / Mitsuba llvm_ad_rgb camera paths per second for one back-to-back pair."""
     table = Path(tmp) / "crosscheck.csv"
     table.unlink(missing_ok=True)
     cmd = [python, str(REPO / "experiments/tools/crosscheck_mitsuba.py"), str(REPO / scene)]
+    cmd += define_args(defines)
     cmd += ["--spp", "64", "--variant", "llvm_ad_rgb", "--threads", str(threads), "--csv", str(table)]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     if proc.returncode != 0 or not table.exists():
@@ -259,6 +278,8 @@ def main(argv):
     p.add_argument("--mitsuba", metavar="PYTHON", help="a Python with the mitsuba package")
     p.add_argument("--smallvcm", type=Path, metavar="PATH",
                    help="a SmallVCM binary: time bdpt against its bpt on smallvcm-cbox (CPU seconds)")
+    p.add_argument("--bitterli", type=Path, metavar="DIR",
+                   help="also time Bitterli's scenes from DIR (veach-mis/, veach-bidir/, cornell-box/)")
     p.add_argument("--out", type=Path, default=REPO / "results" / "perf")
     p.add_argument("--binary", type=Path, default=BINARY, help="the mltbench build to time")
     p.add_argument("--against", type=Path, metavar="OLD",
@@ -273,7 +294,7 @@ def main(argv):
     if not args.binary.exists():
         print(f"error: {args.binary} not found: run `cargo build --release` first", file=sys.stderr)
         return 2
-    scenes = SUITE
+    scenes = [(name, scene, covers, (), False) for name, scene, covers in SUITE]
     if args.only:
         wanted = set(args.only.split(","))
         unknown = wanted - {s[0] for s in SUITE}
@@ -281,7 +302,14 @@ def main(argv):
             print(f"error: --only names unknown scenes {sorted(unknown)}; the suite has "
                   f"{[s[0] for s in SUITE]}", file=sys.stderr)
             return 2
-        scenes = [s for s in SUITE if s[0] in wanted]
+        scenes = [s for s in scenes if s[0] in wanted]
+    if args.bitterli:
+        for name, covers, defines in BITTERLI:
+            path = (args.bitterli / name / "scene.xml").resolve()
+            if not path.exists():
+                print(f"error: --bitterli: {path} not found", file=sys.stderr)
+                return 2
+            scenes.append((f"bitterli {name}", str(path), covers, defines, True))
     estimators = ESTIMATORS
     if args.estimators:
         wanted = set(args.estimators.split(","))
@@ -290,17 +318,17 @@ def main(argv):
     args.out.mkdir(parents=True, exist_ok=True)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        for name, scene, covers in scenes:
-            row = {"scene": name, "file": scene, "covers": covers}
+        for name, scene, covers, defines, extra in scenes:
+            row = {"scene": name, "file": scene, "covers": covers, "extra": extra}
             for label, est_args, spp in estimators:
                 rates, old_rates, error = [], [], None
                 for _ in range(args.repeats):
                     if args.against:
-                        rate, error = render_rate(args.against, scene, est_args, spp, args.threads, tmp)
+                        rate, error = render_rate(args.against, scene, est_args, spp, args.threads, tmp, defines)
                         if rate is None:
                             break
                         old_rates.append(rate)
-                    rate, error = render_rate(args.binary, scene, est_args, spp, args.threads, tmp)
+                    rate, error = render_rate(args.binary, scene, est_args, spp, args.threads, tmp, defines)
                     if rate is None:
                         break
                     rates.append(rate)
@@ -316,7 +344,8 @@ def main(argv):
                 row["mitsuba_skipped"] = NO_MITSUBA[name]
                 print(f"{name:14} mitsuba  skipped: {NO_MITSUBA[name]}", file=sys.stderr)
             elif args.mitsuba:
-                pairs, error = repeated(args.repeats, lambda: mitsuba_ratio(args.mitsuba, scene, args.threads, tmp))
+                pairs, error = repeated(
+                    args.repeats, lambda: mitsuba_ratio(args.mitsuba, scene, args.threads, tmp, defines))
                 if error is None:
                     row["mitsuba_ratio"] = statistics.median(p[0] for p in pairs)
                     row["mitsuba_mpaths"] = statistics.median(p[2] for p in pairs)
@@ -393,22 +422,26 @@ def write_outputs(args, rows, estimators):
         head += " | Mitsuba llvm_ad_rgb | pt / Mitsuba"
         rule += "---|---|"
     lines += [head + " |", rule]
-    ratios = []
+    ratios, extra_ratios = [], []
     for r in rows:
         cells = [r["scene"], r["covers"]]
         cells += [f"{r[k]:.3f}" if r.get(k) is not None else "error" for k in labels]
         if args.mitsuba:
             if "mitsuba_ratio" in r:
                 cells += [f"{r['mitsuba_mpaths']:.3f}", f"{r['mitsuba_ratio']:.2f}"]
-                ratios.append(r["mitsuba_ratio"])
+                (extra_ratios if r["extra"] else ratios).append(r["mitsuba_ratio"])
             elif "mitsuba_skipped" in r:
                 cells += [f"— ({r['mitsuba_skipped']})", ""]
             else:
                 cells += ["error", ""]
         lines.append("| " + " | ".join(cells) + " |")
+    def gmean(xs):
+        return math.exp(sum(math.log(x) for x in xs) / len(xs))
     if ratios:
-        gmean = math.exp(sum(math.log(x) for x in ratios) / len(ratios))
-        lines += ["", f"Geometric mean of pt / Mitsuba over {len(ratios)} scenes: {gmean:.2f}."]
+        lines += ["", f"Geometric mean of pt / Mitsuba over {len(ratios)} scenes: {gmean(ratios):.2f}."]
+    if extra_ratios:
+        lines += ["", f"Bitterli's scenes (at a quarter of their width and height, not in the mean above): "
+                  f"geometric mean {gmean(extra_ratios):.2f} over {len(extra_ratios)}."]
     for r in rows:
         if "bdpt_vs_smallvcm" in r:
             each = ", ".join(f"{a:.2f} / {b:.2f} s" for a, b in r["smallvcm_pairs"])
