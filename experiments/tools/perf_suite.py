@@ -411,6 +411,7 @@ def write_outputs(args, rows, estimators):
         f"`python3 experiments/tools/perf_suite.py --repeats {args.repeats}"
         + (" --mitsuba PYTHON" if args.mitsuba else "")
         + (" --smallvcm PATH" if args.smallvcm else "")
+        + (" --bitterli DIR" if args.bitterli else "")
         + f"`, {args.threads} threads, {time.strftime('%Y-%m-%d')}. Millions of samples per second "
         f"(medians of {args.repeats}; {units}): camera samples for pt and bdpt, light paths for "
         "lt and ppm, mutations for pssmlt (base=bdpt) and mmlt, their bootstrap included.",
