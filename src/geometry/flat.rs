@@ -606,9 +606,27 @@ mod tests {
         );
     }
 
+    /// The same triangles answered through a tree and without one (`FLAT_LIMIT` 0 and ∞).
+    fn tree_and_flat(
+        vertices: &[[Vec3; 3]],
+    ) -> (
+        crate::geometry::bvh::TriangleBvh,
+        crate::geometry::bvh::TriangleBvh,
+    ) {
+        use crate::geometry::bvh::{TriangleBvh, TriangleList};
+        let ids: Vec<[u32; 2]> = (0..vertices.len() as u32).map(|i| [0, i]).collect();
+        let list = TriangleList {
+            vertices,
+            ids: &ids,
+        };
+        let tree = TriangleBvh::build_with_flat_limit(&list, 0);
+        let flat = TriangleBvh::build_with_flat_limit(&list, usize::MAX);
+        (tree, flat)
+    }
+
     #[test]
     fn agrees_with_the_tree_on_the_cornell_box() {
-        use crate::geometry::bvh::{TraversalRay, TriangleBvh, TriangleList};
+        use crate::geometry::bvh::TraversalRay;
         use crate::geometry::procedural::cornell_box;
         use crate::scene::ShapeGeometry;
         let mut vertices = Vec::new();
@@ -617,13 +635,7 @@ mod tests {
                 vertices.extend(m.indices.iter().map(|t| t.map(|i| m.positions[i as usize])));
             }
         }
-        let ids: Vec<[u32; 2]> = (0..vertices.len() as u32).map(|i| [0, i]).collect();
-        let list = TriangleList {
-            vertices: &vertices,
-            ids: &ids,
-        };
-        let tree = TriangleBvh::build_with_flat_limit(&list, 0);
-        let flat = TriangleBvh::build_with_flat_limit(&list, usize::MAX);
+        let (tree, flat) = tree_and_flat(&vertices);
         let mut s = 0x2545_F491_4F6C_DD1Du64;
         let mut hits = 0;
         for i in 0..100_000u32 {
@@ -650,7 +662,7 @@ mod tests {
     /// of query report the same triangle.
     #[test]
     fn the_tree_keeps_the_flat_scans_triangle_among_exact_ties() {
-        use crate::geometry::bvh::{TraversalRay, TriangleBvh, TriangleList};
+        use crate::geometry::bvh::TraversalRay;
         const N: u32 = 30;
         let corner = |i: u32, j: u32| Vec3::new(i as f32, 0.0, j as f32);
         let mut vertices = Vec::new();
@@ -662,13 +674,7 @@ mod tests {
                 vertices.push([a, d, c]);
             }
         }
-        let ids: Vec<[u32; 2]> = (0..vertices.len() as u32).map(|i| [0, i]).collect();
-        let list = TriangleList {
-            vertices: &vertices,
-            ids: &ids,
-        };
-        let tree = TriangleBvh::build_with_flat_limit(&list, 0);
-        let flat = TriangleBvh::build_with_flat_limit(&list, usize::MAX);
+        let (tree, flat) = tree_and_flat(&vertices);
         assert!(!tree.is_flat() && flat.is_flat());
         let mut rays = Vec::new();
         for j in 1..N {
