@@ -28,7 +28,7 @@ use crate::math::lanes::{F32x16, F64x8, LANES, Mask8, Mask16, U32x16, V3};
 /// Trees of at most this many triangles keep a packet (`PacketTriangles`) beside the tree
 /// for the sixteen-ray queries. A packet tests every triangle against all sixteen lanes,
 /// whatever the lanes; the tree traces the active lanes one by one. Measured with `pt`
-/// (full packets) on a rippled mesh of 54 to 166 triangles (`experiments/perf/water.xml`'s
+/// (full packets) on a rippled mesh of 54 to 396 triangles (`experiments/perf/water.xml`'s
 /// scene, `docs/performance.md`): the packet is faster up to about 120 triangles, so a
 /// traversal costs about as much as testing 120/16 ≈ 7 triangles in a packet, and
 /// `Geometry::packet_pays` asks for enough active lanes by that rate.
@@ -630,8 +630,8 @@ impl SurfaceLanes {
 
 impl Geometry {
     /// `closest_hit` for the rays of the lanes of `m`: the same answers, sixteen rays per
-    /// triangle and sphere test on a small scene (`packet.rs`), one ray at a time on a
-    /// scene with a tree.
+    /// triangle and sphere test on a small scene (`packet.rs`) and on a small tree when
+    /// enough lanes are active (`packet_pays`), else one ray at a time through the tree.
     pub fn closest_hits_lanes(&self, rays: &RayLanes, m: Mask16, out: &mut ClosestLanes) {
         if !self.packet_pays(m) {
             self.closest_hits_one_by_one(rays, m, out);
