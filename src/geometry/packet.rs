@@ -793,11 +793,11 @@ impl Geometry {
         if analytic.none() {
             return surface;
         }
-        // Spheres without (u, v) in lanes; disks and spheres with (u, v) through
+        // Spheres in lanes (their (u, v), which `SurfaceLanes` does not hold, is read
+        // lane by lane where a texture needs it: `Geometry::uv`); disks through
         // `interaction`, lane by lane.
         let spheres = Mask16::from_fn(|i| {
-            analytic.get(i)
-                && matches!(hits.analytic[i], Some(Hit::Sphere { index, .. }) if !self.spheres[index].uv)
+            analytic.get(i) && matches!(hits.analytic[i], Some(Hit::Sphere { .. }))
         });
         if spheres.any() {
             surface.merge(spheres, &self.sphere_surface_lanes(hits, rays, spheres));
@@ -810,7 +810,7 @@ impl Geometry {
     }
 
     /// `surface_lanes` for the lanes of `m`, whose closest hits are spheres: `Sphere::hit`
-    /// without (u, v), each lane on its own sphere, in f64 lanes and then f32 ones, the same
+    /// but its (u, v), each lane on its own sphere, in f64 lanes and then f32 ones, the same
     /// operations and so the same bits.
     fn sphere_surface_lanes(
         &self,
