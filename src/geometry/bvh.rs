@@ -306,13 +306,6 @@ impl TriangleBvh {
         self.nodes.is_empty()
     }
 
-    /// True when sixteen-ray queries test every triangle in lanes (`PacketTriangles`):
-    /// flat scenes and trees of at most `PACKET_LIMIT` triangles.
-    #[inline(always)]
-    pub fn has_packet(&self) -> bool {
-        self.is_flat() || !self.packet.is_empty()
-    }
-
     /// Closest triangle with 0 < t < t_max: (record index, its hit data).
     #[inline(always)]
     pub fn closest(&self, ray: &TraversalRay, t_max: f32) -> Option<(u32, TriangleHit)> {
@@ -514,7 +507,8 @@ impl Visitor for Closest<'_> {
                     return false;
                 }
                 *best = Some((id as u32, h));
-                *limit = tie_limit(*best, id as u32 + 1, h.t);
+                // The node's later records come after the new best: no tie can replace it.
+                *limit = h.t;
                 // The surface data of the closest hit will be read from these: start
                 // fetching them while traversal goes on.
                 if let Some(n) = &bvh.normals {

@@ -993,7 +993,7 @@ impl Geometry {
     #[inline(always)]
     fn packet_pays(&self, m: Mask16) -> bool {
         self.bvh.is_flat()
-            || (self.bvh.has_packet()
+            || (!self.bvh.packet().is_empty()
                 && m.count() as usize * PACKET_LIMIT >= LANES * self.bvh.records().len())
     }
 
