@@ -198,13 +198,18 @@ fn pooled_normalisation_converges_to_the_image_mean() {
     let scene = shipped_scene("cbox-spheres.xml", 32);
     let (mean, se) = bdpt_mean_luminance(&scene);
     for (name, param) in METROPOLIS {
-        let params = Params::parse(&[
+        // mmlt's chains that keep their path length weigh by the bootstrap's b per length,
+        // so pooling is for chains that change length.
+        let mut params = vec![
             param,
             "bootstrap=1000",
             "chains=16",
             "normalisation=large_steps",
-        ])
-        .unwrap();
+        ];
+        if name == "mmlt" {
+            params.push("lengths=mutable");
+        }
+        let params = Params::parse(&params).unwrap();
         let mut e = estimator::create(name, &params, &scene, 8).unwrap();
         render(&scene, e.as_mut(), Budget::Passes(64), |_, _| {});
         let d = e.diagnostics().expect("diagnostics");
@@ -254,7 +259,8 @@ fn thread_count_does_not_matter() {
     let variants = [
         ("pssmlt", "importance=relative"),
         ("mmlt", "importance=relative"),
-        ("mmlt", "normalisation=large_steps"),
+        ("mmlt", "lengths=mutable normalisation=large_steps"),
+        ("mmlt", "lengths=mutable"),
     ];
     for (name, param) in METROPOLIS.into_iter().chain(variants) {
         let bits = |threads: usize, seed: u64| -> Vec<u32> {
@@ -262,7 +268,9 @@ fn thread_count_does_not_matter() {
                 .num_threads(threads)
                 .build()
                 .unwrap();
-            let params = Params::parse(&[param, "chains=48", "bootstrap=5000"]).unwrap();
+            let mut params: Vec<&str> = param.split(' ').collect();
+            params.extend(["chains=48", "bootstrap=5000"]);
+            let params = Params::parse(&params).unwrap();
             let mut e = estimator::create(name, &params, &scene, seed).unwrap();
             let image = pool
                 .install(|| render(&scene, e.as_mut(), Budget::Passes(6), |_, _| {}))
@@ -328,6 +336,22 @@ fn bad_parameters_are_refused_naming_them() {
     .unwrap()
     .to_string();
     assert!(err.contains("max_depth"), "{err}");
+    // Chains that keep their path length: one per length at least, weighed by the
+    // bootstrap's b (an 8 × 8 film has 64 pixels, so at most 64 chains move each pass).
+    for (params, expected) in [
+        (&["chains=4", "max_depth=8"][..], "chains = 4"),
+        (&["chains=256", "max_depth=100"][..], "64 chains"),
+        (&["normalisation=large_steps"][..], "normalisation"),
+        (&["lengths=some"][..], "lengths"),
+    ] {
+        let err = estimator::create("mmlt", &Params::parse(params).unwrap(), &scene, 1)
+            .err()
+            .unwrap_or_else(|| panic!("mmlt {params:?} accepted"))
+            .to_string();
+        assert!(err.contains(expected), "{params:?}: {err}");
+    }
+    let mutable = Params::parse(&["chains=4", "max_depth=8", "lengths=mutable"]).unwrap();
+    assert!(estimator::create("mmlt", &mutable, &scene, 1).is_ok());
 }
 
 #[test]

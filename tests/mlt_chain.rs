@@ -15,7 +15,7 @@ use glam::Vec2;
 use mltbench::estimator::mlt::autocorrelation::{SOKAL_C, integrated_autocorrelation_time};
 use mltbench::estimator::mlt::chain::Chain;
 use mltbench::estimator::mlt::importance::ImportanceKind;
-use mltbench::estimator::mlt::settings::{ChainSettings, Normalisation};
+use mltbench::estimator::mlt::settings::{ChainSettings, Lengths, Normalisation};
 use mltbench::estimator::mlt::target::Contributions;
 use mltbench::film::SplatList;
 use mltbench::math::Rgb;
@@ -181,6 +181,7 @@ fn settings(large_step: f64, mutation: Mutation) -> ChainSettings {
         kelemen_weights: false,
         importance: ImportanceKind::Luminance,
         normalisation: Normalisation::Bootstrap,
+        lengths: Lengths::Mutable,
     }
 }
 

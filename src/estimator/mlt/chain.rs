@@ -61,6 +61,12 @@ pub struct Chain {
     pub counts: ChainCounts,
     /// The current state's importance after each of the first `RECORDED_STEPS` steps.
     pub luminance_series: Vec<f32>,
+    /// The stratum the chain is confined to (`mmlt` with `lengths=fixed`: its path
+    /// length), or None when its states range over every stratum.
+    pub stratum: Option<usize>,
+    /// Every splat's factor beyond b / I: 1, or for a chain confined to a stratum the
+    /// pass's mutations over its stratum's (`Metropolis::start`).
+    pub scale: f64,
 }
 
 impl Chain {
@@ -72,13 +78,15 @@ impl Chain {
             proposal: Contributions::default(),
             counts: ChainCounts::default(),
             luminance_series: Vec::new(),
+            stratum: None,
+            scale: 1.0,
         }
     }
 
     /// One Metropolis–Hastings step: propose (the sampler mutates), evaluate with
     /// `evaluate` (which reads the proposal through the sampler and returns rays cast and
     /// contributions dropped), splat both states' expected values to `splats` (scaled by
-    /// the normalisation `b`), accept or reject.
+    /// the normalisation `b` of the chain's target and by `scale`), accept or reject.
     pub fn step(
         &mut self,
         settings: &ChainSettings,
@@ -111,8 +119,8 @@ impl Chain {
             };
             (new, old)
         };
-        splat(splats, &self.current, w_old);
-        splat(splats, &self.proposal, w_new);
+        splat(splats, &self.current, w_old * self.scale);
+        splat(splats, &self.proposal, w_new * self.scale);
         let accept = a >= 1.0 || self.sampler.uniform() < a;
         if large {
             self.counts.large_proposed += 1;

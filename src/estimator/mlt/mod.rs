@@ -52,7 +52,7 @@ use diagnostics::{Bootstrap, Diagnostics};
 use glam::Vec2;
 use importance::{ImportanceKind, PilotMap};
 use multiplexed::MultiplexedTarget;
-use settings::{ChainSettings, Normalisation};
+use settings::{ChainSettings, Lengths, Normalisation};
 use target::{BdptTarget, Contributions, PathTarget, PtTarget};
 
 /// Keys that keep the bootstrap's, the chains' and the selection's streams apart.
@@ -150,8 +150,68 @@ pub fn mmlt(params: &Params, scene: &Scene, seed: u64) -> Result<Mmlt> {
              integrator max_depth",
         ));
     };
+    let mut settings = settings;
+    settings.lengths = Lengths::from_params(params)?;
+    if settings.lengths == Lengths::Fixed {
+        check_fixed_lengths(&settings, scene, max_depth)?;
+    }
     let target = MultiplexedTarget::new(path, mis_from_params(params)?, max_depth);
     Metropolis::new("mmlt", None, scene, seed, settings, target)
+}
+
+/// `lengths=fixed` gives every path length the bootstrap finds lit a chain of its own, and
+/// a chain that takes no mutation in a pass (there are more chains than pixels) would leave
+/// its length out of the image; its weights need b fixed by the bootstrap.
+fn check_fixed_lengths(settings: &ChainSettings, scene: &Scene, max_depth: u32) -> Result<()> {
+    let window = scene.description.sensor.film.window();
+    let pixels = window.width as u64 * window.height as u64;
+    let usable = (settings.chains as u64).min(pixels);
+    if usable < max_depth as u64 {
+        return Err(Error::usage(format!(
+            "--set lengths=fixed: {usable} chains that move every pass (chains = {}, {pixels} \
+             pixels) for max_depth = {max_depth} path lengths; raise chains, lower max_depth \
+             or set lengths=mutable",
+            settings.chains
+        )));
+    }
+    if settings.normalisation == Normalisation::LargeSteps {
+        return Err(Error::usage(
+            "--set normalisation=large_steps: not with lengths=fixed (each length's chains \
+             are weighed by the bootstrap's b of that length)",
+        ));
+    }
+    Ok(())
+}
+
+/// Chains per stratum for `lengths=fixed`: in proportion to the strata's mean importances
+/// `means` (largest remainders), at least one for every stratum whose mean is above 0 and
+/// none for the others. `chains` must be at least the number of strata.
+pub fn chains_per_stratum(means: &[f64], chains: usize) -> Vec<usize> {
+    let total: f64 = means.iter().sum();
+    let lit = means.iter().filter(|&&m| m > 0.0).count();
+    if lit == 0 {
+        return vec![0; means.len()];
+    }
+    // One chain each for the lit strata, the rest in proportion.
+    let rest = chains.saturating_sub(lit);
+    let exact: Vec<f64> = means.iter().map(|&m| m / total * rest as f64).collect();
+    let mut counts: Vec<usize> = means
+        .iter()
+        .zip(&exact)
+        .map(|(&m, &x)| if m > 0.0 { 1 + x as usize } else { 0 })
+        .collect();
+    // The floors leave fewer chains than lit strata: one more each to the largest
+    // remainders (ties to the lower stratum).
+    let left = chains.saturating_sub(counts.iter().sum::<usize>());
+    let mut order: Vec<usize> = (0..means.len()).filter(|&k| means[k] > 0.0).collect();
+    order.sort_by(|&i, &j| {
+        let (ri, rj) = (exact[i] - exact[i].floor(), exact[j] - exact[j].floor());
+        rj.total_cmp(&ri).then(i.cmp(&j))
+    });
+    for &k in order.iter().take(left) {
+        counts[k] += 1;
+    }
+    counts
 }
 
 /// A scene without a light has nothing to explore: an error naming the scene.
@@ -171,6 +231,18 @@ fn merge(film: &mut Film, lists: &mut [SplatList]) {
         film.merge_splats(list);
         list.clear();
     }
+}
+
+/// Where a group of chains starts and how its splats are weighed (`Metropolis::start`).
+struct ChainPlacement {
+    /// The bootstrap points they start from (by systematic resampling in proportion to
+    /// importance).
+    range: std::ops::Range<usize>,
+    chains: usize,
+    /// The stratum they keep (`lengths=fixed`), or None.
+    fixed: Option<usize>,
+    /// `Chain::scale`.
+    scale: f64,
 }
 
 /// Mutations chain `k` of `chains` takes in one pass of `pixels` mutations.
@@ -313,37 +385,99 @@ impl<T: PathTarget> Metropolis<T> {
                 Some(*acc)
             })
             .collect();
-        let total = *prefix.last().unwrap();
-        let chains = self.settings.chains as u64;
+        let placements = match self.settings.lengths {
+            Lengths::Mutable => {
+                let chains = self.settings.chains as usize;
+                let everywhere = ChainPlacement {
+                    range: 0..prefix.len(),
+                    chains,
+                    fixed: None,
+                    scale: 1.0,
+                };
+                vec![everywhere]
+            }
+            Lengths::Fixed => self.fixed_placements(&bootstrap, n as usize),
+        };
         let this = &*self;
-        let started: Vec<Chain> = (0..chains)
+        let chain_list: Vec<(u64, u64, &ChainPlacement)> = placements
+            .iter()
+            .flat_map(|p| (0..p.chains as u64).map(move |i| (i, p)))
+            .enumerate()
+            .map(|(k, (i, p))| (k as u64, i, p))
+            .collect();
+        let started: Vec<Chain> = chain_list
             .into_par_iter()
-            .map(|k| {
+            .map(|(k, i, placement)| {
+                // Systematic resampling within the placement's bootstrap points.
+                let range = &placement.range;
+                let below = if range.start == 0 {
+                    0.0
+                } else {
+                    prefix[range.start - 1]
+                };
+                let span = prefix[range.end - 1] - below;
                 let xi = to_unit_f32(hash_words(&[seed, SELECT_KEY, k])) as f64;
-                let target_sum = (k as f64 + xi) / chains as f64 * total;
-                let j = prefix
+                let target_sum = below + (i as f64 + xi) / placement.chains as f64 * span;
+                let j = prefix[range.clone()]
                     .partition_point(|&p| p <= target_sum)
-                    .min(prefix.len() - 1) as u64;
+                    .min(range.len() - 1)
+                    + range.start;
+                let j = j as u64;
                 let stratum = (j / n) as usize;
                 let mut sampler = this.sampler(&[seed, BOOTSTRAP_KEY, j]);
                 let mut scratch = T::Scratch::default();
                 let mut out = Contributions::default();
                 this.target
                     .evaluate(scene, &mut sampler, Some(stratum), &mut scratch, &mut out);
-                // The same point in the chain's coordinates, evaluated as a chain state.
-                this.target.to_chain_state(&mut sampler, stratum);
-                sampler.restart_evaluation();
-                this.target
-                    .evaluate(scene, &mut sampler, None, &mut scratch, &mut out);
+                if placement.fixed.is_none() {
+                    // The same point in the chain's coordinates, evaluated as a chain state.
+                    this.target.to_chain_state(&mut sampler, stratum);
+                    sampler.restart_evaluation();
+                    this.target
+                        .evaluate(scene, &mut sampler, None, &mut scratch, &mut out);
+                }
                 if let Some(map) = &this.pilot {
                     out.luminance = map.importance(&out);
                 }
                 sampler.start_chain(&[seed, CHAIN_KEY, k]);
-                Chain::new(sampler, out)
+                let mut chain = Chain::new(sampler, out);
+                chain.stratum = placement.fixed;
+                chain.scale = placement.scale;
+                chain
             })
             .collect();
         self.chains = started;
         self.bootstrap = Some(bootstrap);
+    }
+
+    /// `lengths=fixed`: where each stratum's chains start and how they weigh their splats.
+    /// Stratum k gets chains in proportion to its mean importance b_k, each placed among
+    /// its own `per_stratum` bootstrap points; with m_k of a pass's mutations, its splats
+    /// are scaled by (b_k / b)·(mutations / m_k), so that it adds b_k times its chains'
+    /// mean (b × splats / mutations per pixel, as every chain's image is read).
+    fn fixed_placements(&self, bootstrap: &Bootstrap, per_stratum: usize) -> Vec<ChainPlacement> {
+        let pixels = self.film.width() as u64 * self.film.height() as u64;
+        let usable = (self.settings.chains as u64).min(pixels);
+        let counts = chains_per_stratum(&bootstrap.stratum_means, usable as usize);
+        let mut first = 0u64;
+        let mut placements = Vec::new();
+        for (k, &c) in counts.iter().enumerate() {
+            if c == 0 {
+                continue;
+            }
+            let mutations: u64 = (first..first + c as u64)
+                .map(|i| share(pixels, usable, i))
+                .sum();
+            first += c as u64;
+            let b_k = bootstrap.stratum_means[k];
+            placements.push(ChainPlacement {
+                range: k * per_stratum..(k + 1) * per_stratum,
+                chains: c,
+                fixed: Some(k),
+                scale: b_k / bootstrap.b * pixels as f64 / mutations as f64,
+            });
+        }
+        placements
     }
 
     /// The counts of every chain, summed.
@@ -457,9 +591,10 @@ impl<T: PathTarget> Estimator for Metropolis<T> {
                         .enumerate()
                         .for_each_init(T::Scratch::default, |scratch, (k, (chain, list))| {
                             list.clear();
+                            let stratum = chain.stratum;
                             for _ in 0..share(pixels, n_chains, k as u64) {
                                 chain.step(&settings, b, list, |sampler, out| {
-                                    let e = target.evaluate(scene, sampler, None, scratch, out);
+                                    let e = target.evaluate(scene, sampler, stratum, scratch, out);
                                     if let Some(map) = pilot {
                                         out.luminance = map.importance(out);
                                     }
@@ -496,5 +631,44 @@ impl<T: PathTarget> Estimator for Metropolis<T> {
 
     fn diagnostics(&self) -> Option<serde_json::Value> {
         serde_json::to_value(self.diagnostics_report()?).ok()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn chains_are_shared_out_over_strata_in_proportion() {
+        // In proportion where the shares are whole.
+        assert_eq!(chains_per_stratum(&[1.0, 2.0, 1.0], 4 + 3), vec![2, 3, 2]);
+        // Every lit stratum one chain at least, dark ones none; the total is kept.
+        let counts = chains_per_stratum(&[0.0, 100.0, 1e-6, 0.0, 5.0], 10);
+        assert_eq!(counts.iter().sum::<usize>(), 10);
+        assert_eq!((counts[0], counts[3]), (0, 0));
+        assert!(
+            counts[2] == 1 && counts[1] > counts[4] && counts[4] >= 1,
+            "{counts:?}"
+        );
+        // Largest remainders: 3 chains left after one each over shares 0.5, 0.3, 0.2
+        // make 1.5, 0.9, 0.6, rounded to 2, 1, 0 … and then the remainders 0.9 and 0.6.
+        assert_eq!(chains_per_stratum(&[5.0, 3.0, 2.0], 6), vec![2, 2, 2]);
+        assert_eq!(chains_per_stratum(&[0.0, 0.0], 8), vec![0, 0]);
+        for chains in 4..200 {
+            let means = [0.3, 0.0, 2.0, 0.01, 1.0];
+            let counts = chains_per_stratum(&means, chains);
+            assert_eq!(counts.iter().sum::<usize>(), chains);
+            // Within one chain of the proportional share of the chains beyond the first.
+            let rest = (chains - 4) as f64 / 3.31;
+            for (k, &m) in means.iter().enumerate() {
+                if m > 0.0 {
+                    let want = 1.0 + m * rest;
+                    assert!(
+                        (counts[k] as f64 - want).abs() < 1.0,
+                        "{chains}: {counts:?}"
+                    );
+                }
+            }
+        }
     }
 }

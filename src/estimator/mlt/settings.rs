@@ -23,6 +23,36 @@ pub struct ChainSettings {
     pub importance: ImportanceKind,
     /// Where the normalisation b comes from.
     pub normalisation: Normalisation,
+    /// Whether a chain keeps the stratum it starts in (`mmlt`'s `lengths`; `pssmlt` has
+    /// one stratum and leaves it `Mutable`).
+    pub lengths: Lengths,
+}
+
+/// Whether `mmlt`'s chains may change path length (`--set lengths=…`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Lengths {
+    /// A state's path length is one of its primary numbers: small steps keep it, large
+    /// steps draw it afresh, so a chain wanders over every length.
+    Mutable,
+    /// Each chain keeps one path length for the whole run, which stratifies the image
+    /// over path lengths: the chains are shared out over the lengths in proportion to the
+    /// bootstrap's b_d, and a chain of length d weighs its
+    /// splats by b_d over its length's share of the mutations. The lengths' shares of the
+    /// image are then fixed by the bootstrap instead of by how long the chains linger.
+    Fixed,
+}
+
+impl Lengths {
+    /// Reads `lengths` (fixed, the default, or mutable).
+    pub fn from_params(params: &Params) -> Result<Lengths> {
+        match params.get("lengths", "fixed".to_string())?.as_str() {
+            "mutable" => Ok(Lengths::Mutable),
+            "fixed" => Ok(Lengths::Fixed),
+            other => Err(Error::usage(format!(
+                "--set lengths={other}: expected mutable or fixed"
+            ))),
+        }
+    }
 }
 
 /// Where the normalisation b (the mean importance) comes from.
@@ -129,6 +159,7 @@ impl ChainSettings {
             kelemen_weights,
             importance,
             normalisation,
+            lengths: Lengths::Mutable,
         })
     }
 }

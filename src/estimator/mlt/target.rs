@@ -65,8 +65,9 @@ pub trait PathTarget: Sync + Send {
     }
 
     /// Evaluates the point the sampler's numbers make, into `out` (cleared first). With
-    /// `stratum`, the point is a bootstrap sample confined to that stratum (`mmlt`: that
-    /// path length); without, a chain's state.
+    /// `stratum`, the point is confined to that stratum (`mmlt`: that path length): a
+    /// bootstrap sample, or the state of a chain that keeps its stratum; without, the
+    /// state of a chain that ranges over every stratum.
     fn evaluate<'a>(
         &self,
         scene: &'a Scene,
