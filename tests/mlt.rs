@@ -8,6 +8,8 @@
 //! * the normalisation b agrees with a long `bdpt` image's mean luminance within 4 of their
 //!   combined standard errors;
 //! * `large_step=1` (every proposal independent) agrees with the base estimator;
+//! * `mmlt` with chains that change path length (`lengths=mutable`) as well as with the
+//!   default, chains that keep one;
 //! * `importance=relative` (the target divided by a pilot of each pixel) agrees with `bdpt`
 //!   where the image's contrast is highest: the door ajar, a small light behind glass;
 //! * bit-identical images for 1 and 2 threads;
@@ -130,6 +132,60 @@ fn agrees_with_bdpt_where_light_comes_through_a_gap() {
     ] {
         let scene = shipped_scene(file, res);
         assert_metropolis_agrees_with_bdpt(file, &scene, &[], &[], passes, seed);
+    }
+}
+
+/// `mmlt` with `lengths=mutable` (chains that change path length; the default keeps each
+/// chain at one length) against `bdpt`: on the spheres' caustics and behind the door.
+#[test]
+fn mutable_lengths_agree_with_bdpt() {
+    for (file, res, passes, seed) in [
+        ("cbox-spheres.xml", 32, 32, 1400),
+        ("door-ajar-indirect.xml", 16, 128, 1500),
+    ] {
+        let scene = shipped_scene(file, res);
+        let bdpt = runs("bdpt", &scene, &[], 8, passes, seed);
+        let mut params = vec!["lengths=mutable"];
+        params.extend(SHORT);
+        let mmlt = runs("mmlt", &scene, &params, 8, passes, seed + 10);
+        let what = format!("{file}: mmlt lengths=mutable");
+        assert_means_agree(&what, &mmlt, &bdpt);
+        assert_blocks_agree_of(&what, &mmlt, &bdpt, 16);
+    }
+}
+
+/// `mmlt`'s default chains keep one path length each: the diagnostics say how many each
+/// length got (every length the bootstrap found lit at least one, the rest none, all
+/// chains used); chains that change length report none.
+#[test]
+fn fixed_lengths_share_the_chains_out_over_lengths() {
+    let scene = shipped_scene("cbox.xml", 16);
+    for (lengths, fixed) in [("lengths=fixed", true), ("lengths=mutable", false)] {
+        let params = Params::parse(&[lengths, "chains=64", "bootstrap=4000"]).unwrap();
+        let mut e = estimator::create("mmlt", &params, &scene, 3).unwrap();
+        render(&scene, e.as_mut(), Budget::Passes(1), |_, _| {});
+        let d = e.diagnostics().unwrap();
+        if !fixed {
+            assert!(d["chains_per_stratum"].is_null(), "{d}");
+            continue;
+        }
+        let per: Vec<u64> = d["chains_per_stratum"]
+            .as_array()
+            .expect("chains per length")
+            .iter()
+            .map(|v| v.as_u64().unwrap())
+            .collect();
+        let means: Vec<f64> = d["bootstrap"]["stratum_means"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        assert_eq!(per.len(), 8, "cbox.xml's max_depth");
+        assert_eq!(per.iter().sum::<u64>(), 64);
+        for (k, (&n, &m)) in per.iter().zip(&means).enumerate() {
+            assert_eq!(n > 0, m > 0.0, "length {}: {n} chains, b_d {m}", k + 1);
+        }
     }
 }
 

@@ -92,6 +92,9 @@ pub struct Diagnostics {
     pub chains: u64,
     /// Chains that accepted no proposal.
     pub chains_never_moved: u64,
+    /// Chains per stratum when each keeps one (`mmlt` with `lengths=fixed`: per path
+    /// length, length 1 first); None when chains range over every stratum.
+    pub chains_per_stratum: Option<Vec<u64>>,
     pub mutations: u64,
     pub acceptance: Acceptance,
     pub small_steps: Acceptance,
@@ -153,6 +156,13 @@ impl Diagnostics {
                 .iter()
                 .filter(|c| c.counts.steps() > 0 && c.counts.accepted() == 0)
                 .count() as u64,
+            chains_per_stratum: chains.iter().any(|c| c.stratum.is_some()).then(|| {
+                let mut per = vec![0; bootstrap.stratum_means.len()];
+                for k in chains.iter().filter_map(|c| c.stratum) {
+                    per[k] += 1;
+                }
+                per
+            }),
             mutations,
             acceptance: Acceptance::new(mutations, counts.accepted()),
             small_steps: Acceptance::new(counts.small_proposed, counts.small_accepted),
