@@ -109,14 +109,30 @@ fn assert_metropolis_agrees_with_bdpt(
     let bdpt = runs("bdpt", scene, extra, 8, passes, seed);
     for (k, (name, param)) in METROPOLIS.iter().enumerate() {
         let mut params = vec![*param];
-        params.extend(SHORT);
         params.extend(extra);
         params.extend(chain_extra);
-        let mlt = runs(name, scene, &params, 8, passes, seed + 10 * (k as u64 + 1));
         let what = format!("{file}: {name} {param} {}", chain_extra.join(" "));
-        assert_means_agree(&what, &mlt, &bdpt);
-        assert_blocks_agree_of(&what, &mlt, &bdpt, 16);
+        let seed = seed + 10 * (k as u64 + 1);
+        assert_short_runs_agree(&what, scene, name, &params, passes, seed, &bdpt);
     }
+}
+
+/// 8 short runs of Metropolis estimator `name` (with `params` and `SHORT`) against the runs
+/// `against`: image means and 16 × 16 blocks.
+fn assert_short_runs_agree(
+    what: &str,
+    scene: &Scene,
+    name: &str,
+    params: &[&str],
+    passes: u32,
+    seed: u64,
+    against: &[Image],
+) {
+    let mut params = params.to_vec();
+    params.extend(SHORT);
+    let mlt = runs(name, scene, &params, 8, passes, seed);
+    assert_means_agree(what, &mlt, against);
+    assert_blocks_agree_of(what, &mlt, against, 16);
 }
 
 /// The rest of the shipped scenes, where light takes one narrow way: through a door ajar
@@ -145,12 +161,9 @@ fn mutable_lengths_agree_with_bdpt() {
     ] {
         let scene = shipped_scene(file, res);
         let bdpt = runs("bdpt", &scene, &[], 8, passes, seed);
-        let mut params = vec!["lengths=mutable"];
-        params.extend(SHORT);
-        let mmlt = runs("mmlt", &scene, &params, 8, passes, seed + 10);
         let what = format!("{file}: mmlt lengths=mutable");
-        assert_means_agree(&what, &mmlt, &bdpt);
-        assert_blocks_agree_of(&what, &mmlt, &bdpt, 16);
+        let params = ["lengths=mutable"];
+        assert_short_runs_agree(&what, &scene, "mmlt", &params, passes, seed + 10, &bdpt);
     }
 }
 
@@ -300,12 +313,9 @@ fn large_steps_only_agree_with_the_base_estimator() {
     for (base, seed) in [("pt", 4000), ("bdpt", 4100)] {
         let own = runs(base, &scene, &[], 8, 32, seed);
         let param = format!("base={base}");
-        let mut params = vec![param.as_str(), "large_step=1"];
-        params.extend(SHORT);
-        let mlt = runs("pssmlt", &scene, &params, 8, 32, seed + 50);
+        let params = [param.as_str(), "large_step=1"];
         let what = format!("pssmlt base={base} large_step=1");
-        assert_means_agree(&what, &mlt, &own);
-        assert_blocks_agree_of(&what, &mlt, &own, 16);
+        assert_short_runs_agree(&what, &scene, "pssmlt", &params, 32, seed + 50, &own);
     }
 }
 
