@@ -140,7 +140,7 @@ pub fn pssmlt(params: &Params, scene: &Scene, seed: u64) -> Result<Box<dyn Estim
 
 /// Makes `mmlt` for `scene`; `max_depth` must be finite.
 pub fn mmlt(params: &Params, scene: &Scene, seed: u64) -> Result<Mmlt> {
-    let settings = ChainSettings::from_params(params, false)?;
+    let mut settings = ChainSettings::from_params(params, false)?;
     let path = PathSettings::from_params(params, scene)?;
     check_lights(scene, "mmlt")?;
     let Some(max_depth) = path.max_depth else {
@@ -150,7 +150,6 @@ pub fn mmlt(params: &Params, scene: &Scene, seed: u64) -> Result<Mmlt> {
              integrator max_depth",
         ));
     };
-    let mut settings = settings;
     settings.lengths = Lengths::from_params(params)?;
     if settings.lengths == Lengths::Fixed {
         check_fixed_lengths(&settings, scene, max_depth)?;
@@ -165,7 +164,7 @@ pub fn mmlt(params: &Params, scene: &Scene, seed: u64) -> Result<Mmlt> {
 fn check_fixed_lengths(settings: &ChainSettings, scene: &Scene, max_depth: u32) -> Result<()> {
     let window = scene.description.sensor.film.window();
     let pixels = window.width as u64 * window.height as u64;
-    let usable = (settings.chains as u64).min(pixels);
+    let usable = moving_chains(settings.chains, pixels);
     if usable < max_depth as u64 {
         return Err(Error::usage(format!(
             "--set lengths=fixed: {usable} chains that move every pass (chains = {}, {pixels} \
@@ -243,6 +242,12 @@ struct ChainPlacement {
     fixed: Option<usize>,
     /// `Chain::scale`.
     scale: f64,
+}
+
+/// Chains that take a mutation in every pass of `pixels` mutations (`share` gives none to
+/// chains beyond the pixel count).
+fn moving_chains(chains: u32, pixels: u64) -> u64 {
+    (chains as u64).min(pixels)
 }
 
 /// Mutations chain `k` of `chains` takes in one pass of `pixels` mutations.
@@ -457,7 +462,7 @@ impl<T: PathTarget> Metropolis<T> {
     /// mean (b × splats / mutations per pixel, as every chain's image is read).
     fn fixed_placements(&self, bootstrap: &Bootstrap, per_stratum: usize) -> Vec<ChainPlacement> {
         let pixels = self.film.width() as u64 * self.film.height() as u64;
-        let usable = (self.settings.chains as u64).min(pixels);
+        let usable = moving_chains(self.settings.chains, pixels);
         let counts = chains_per_stratum(&bootstrap.stratum_means, usable as usize);
         let mut first = 0u64;
         let mut placements = Vec::new();
