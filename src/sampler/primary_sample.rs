@@ -71,24 +71,21 @@ impl SmallStep {
                 if n >= self.uniform_after {
                     return unit_f64(rng);
                 }
-                // Two steps per 64-bit draw, each from 32 bits: the top one the sign, the
-                // other 31 the size's uniform. The offsets are summed and wrapped once:
-                // on the torus that is the same composition.
-                let rate = self.log_ratio as f32;
-                let step = |bits: u32| {
-                    let u = (bits & 0x7fff_ffff) as f32 * (1.0 / (1u64 << 31) as f32);
-                    let size = s2 * exp_neg(rate * u) as f64;
-                    if bits >> 31 == 0 { size } else { -size }
-                };
-                let mut offset = 0.0;
-                for _ in 0..n / 2 {
-                    let bits = rng.next_u64();
-                    offset += step((bits >> 32) as u32) + step(bits as u32);
+                let mut v = value;
+                for _ in 0..n {
+                    let u = unit_f64(rng);
+                    // One number gives both the sign and the size.
+                    let (sign, u) = if u < 0.5 {
+                        (1.0, 2.0 * u)
+                    } else {
+                        (-1.0, 2.0 * u - 1.0)
+                    };
+                    // The size in f32 (the coordinate is read as f32): expf is the cheaper
+                    // exponential, and any size distribution keeps the step symmetric.
+                    let size = ((-self.log_ratio * u) as f32).exp() as f64;
+                    v = wrap(v + sign * s2 * size);
                 }
-                if n % 2 == 1 {
-                    offset += step((rng.next_u64() >> 32) as u32);
-                }
-                wrap(value + offset)
+                v
             }
             Mutation::Gaussian { sigma } => {
                 let z = standard_normal(rng);
@@ -96,25 +93,6 @@ impl SmallStep {
             }
         }
     }
-}
-
-/// e^(−x) for x ≥ 0 in f32, within 5·10⁻⁷ relative for x ≤ 4 (Kelemen's default steps
-/// need x ≤ ln 16) and 6·10⁻⁸·x beyond, from rounding x·log2(e) (`tests::exp_neg_is_close`): 2^(−y)
-/// for y = x·log2(e), split into 2^(−k) for the nearest integer k (the exponent bits) and
-/// 2^(k−y) = e^t for |t| ≤ ln(2)/2 (its Taylor series to t⁶, remainder below 1.3·10⁻⁷).
-/// Arithmetic in line instead of a call to expf: a Kelemen step takes one per step, and
-/// only the steps' symmetry (their random sign) matters for the chain's correctness, not
-/// the last bit of their size.
-#[inline(always)]
-fn exp_neg(x: f32) -> f32 {
-    let y = (x * std::f32::consts::LOG2_E).min(126.0);
-    let k = y.round();
-    let t = (k - y) * std::f32::consts::LN_2;
-    let e_t = 1.0
-        + t * (1.0
-            + t * (1.0 / 2.0
-                + t * (1.0 / 6.0 + t * (1.0 / 24.0 + t * (1.0 / 120.0 + t * (1.0 / 720.0))))));
-    e_t * f32::from_bits(((127 - k as i32) as u32) << 23)
 }
 
 /// `v` wrapped into [0, 1) (the primary sample space is a torus).
@@ -428,22 +406,6 @@ mod tests {
         let next = read(&mut s, 3);
         assert_ne!(next[..3], first[..3]);
         assert_eq!(s.dimensions(), [3, 3, 3]);
-    }
-
-    /// `exp_neg` against f64's exponential over the range Kelemen's steps use and beyond.
-    #[test]
-    fn exp_neg_is_close() {
-        for (end, bound) in [(4.0, 5e-7), (20.0, 1.5e-6)] {
-            let mut worst = 0.0f64;
-            for i in 0..=200_000 {
-                let x = i as f32 / 200_000.0 * end;
-                let exact = (-(x as f64)).exp();
-                worst = worst.max((exp_neg(x) as f64 / exact - 1.0).abs());
-            }
-            assert!(worst < bound, "x ≤ {end}: largest relative error {worst:e}");
-        }
-        // Beyond f32's normal range the result stays finite and tiny.
-        assert!(exp_neg(1e6) >= 0.0 && exp_neg(1e6) < 1e-37);
     }
 
     #[test]
