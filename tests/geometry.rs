@@ -864,8 +864,8 @@ fn stream_queries_match_single_ray_queries() {
 
 /// Sixteen rays per query (`closest_hits_lanes`, `surface_lanes`, `occluded_lanes`): each
 /// lane must answer exactly as the per-ray queries do (same surface, same bits), on small
-/// scenes tested sixteen rays per triangle and sphere (with and without analytic shapes)
-/// and on a scene answered one ray at a time (a tree). The rays include ones aimed exactly at shared vertices (zero edge
+/// scenes tested sixteen rays per triangle and sphere (with and without analytic shapes),
+/// on a small tree answered either way, and on a scene answered one ray at a time (a tree). The rays include ones aimed exactly at shared vertices (zero edge
 /// functions), rays leaving surfaces (T near its error bound), short segments and rays
 /// that cannot hit anything.
 #[test]
@@ -894,14 +894,29 @@ fn packet_queries_match_single_ray_queries() {
         * Mat4::from_rotation_y(0.9)
         * Mat4::from_scale(Vec3::splat(0.35));
     small_analytic.push(disk_shape(disk, true));
+    // A small tree (49 to 112 triangles): full packets test every triangle in record
+    // order, part-empty ones go through the tree in traversal order, and both must keep
+    // the same hit (rays from inside the blocks meet their bottom faces and the floor
+    // beneath at nearly the same t).
+    let mut small_tree = cornell_box(1.0);
+    small_tree.push(mesh_shape(
+        "rounded",
+        cube_sphere(Vec3::new(0.6, 0.3, 0.4), 0.15, 2),
+    ));
     for (name, shapes) in [
         ("small", small),
         ("small and analytic", small_analytic),
+        ("small tree", small_tree),
         ("tree and analytic", scaled_scene(1.0, Vec3::ZERO)),
     ] {
         let g = Geometry::build(&shapes);
-        if name.starts_with("small") {
-            let n = g.triangle_count();
+        let n = g.triangle_count();
+        if name == "small tree" {
+            assert!(
+                n > mltbench::geometry::flat::FLAT_LIMIT && n <= 112,
+                "{n} triangles"
+            );
+        } else if name.starts_with("small") {
             assert!(n <= mltbench::geometry::flat::FLAT_LIMIT, "{n} triangles");
         }
         let vertices: Vec<Vec3> = shapes
