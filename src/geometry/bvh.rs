@@ -541,8 +541,8 @@ pub(crate) fn replaces(best: Option<(u32, TriangleHit)>, id: u32, t: f32) -> boo
 
 /// The segment end to test records from index `first` on against: `t_max` (the best t, or
 /// the ray's end before any hit), or two floats beyond the best t when `first` precedes the
-/// best record, so that an exact tie passes the triangle test's scaled pre-check
-/// (`triangle::hit_from`: T < t_max·det, rounded) and reaches `replaces`.
+/// best record, so that an exact tie passes the triangle test's t < t_max
+/// (`triangle::hit_from`) and reaches `replaces`.
 #[inline(always)]
 pub(crate) fn tie_limit(best: Option<(u32, TriangleHit)>, first: u32, t_max: f32) -> f32 {
     match best {
