@@ -25,7 +25,7 @@
 //! leaf triangle; `pt` on the 330k-triangle mesh ran 12% faster, on the 4k-triangle water
 //! mesh 3% (docs/performance.md).
 
-use super::triangle::{self, PRECHECK_SLACK, TriangleHit, TriangleRay, TriangleRecord};
+use super::triangle::{self, TriangleHit, TriangleRay, TriangleRecord, cut_bound};
 use crate::math::lanes::{F32x16, NATIVE, Real, U32x16};
 
 /// Triangles per chunk: one `F32x16` (one AVX-512 register, or two AVX2 ones).
@@ -282,7 +282,7 @@ fn lane_tests_in_registers(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests 
     let sign = U32x16::splat(0x8000_0000);
     let t_num_p = F32x16::from_bits(t_num.to_bits() ^ (det.to_bits() & sign));
     let det_p = det.abs();
-    let in_range = zero.lt(t_num_p) & t_num_p.le(splat(t_max) * det_p * splat(PRECHECK_SLACK));
+    let in_range = zero.lt(t_num_p) & t_num_p.le(cut_bound(splat(t_max), det_p));
     let keep = !(any_neg & any_pos) & (!all_nonzero | in_range);
     let mut out = LaneTests {
         e: [[0.0; LANES]; 3],
@@ -341,7 +341,7 @@ fn lane_tests_portable(c: &Chunk, r: &TriangleRay, t_max: f32) -> LaneTests {
         // False when det or T is NaN. Such a lane with no zero edge function (padding
         // lanes; overflowing coordinates) is dropped, as the per-triangle test rejects it
         // (its det is NaN too); one with a zero edge is kept by `!all_nonzero`, for f64.
-        let in_range = (t_num_p > 0.0) & (t_num_p <= t_max * det_p * PRECHECK_SLACK);
+        let in_range = (t_num_p > 0.0) & (t_num_p <= cut_bound(t_max, det_p));
         let keep = !(any_neg & any_pos) & (!all_nonzero | in_range);
         let max3 = |a: f32, b: f32, c: f32| a.abs().max(b.abs()).max(c.abs());
         let bound = triangle::t_num_error_bound_in(

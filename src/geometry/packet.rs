@@ -379,8 +379,7 @@ fn lane_tests(
     let sign = det.to_bits() & U32x16::splat(0x8000_0000);
     let t_num_p = F32x16::from_bits(t_num.to_bits() ^ sign);
     let det_p = det.abs();
-    let in_range =
-        t_num_p.gt(zero) & t_num_p.le(t_max * det_p * F32x16::splat(triangle::PRECHECK_SLACK));
+    let in_range = t_num_p.gt(zero) & t_num_p.le(triangle::cut_bound(t_max, det_p));
     let candidate = m & !mixed & (!all_nonzero | in_range);
     LaneTests {
         sheared,

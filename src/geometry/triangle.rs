@@ -260,7 +260,7 @@ fn finish(
     })
 }
 
-/// The slack of every test's first cut T ≤ t_max·det·(1 + 2⁻²¹), taken before dividing:
+/// The bound of every test's first cut T ≤ t_max·det·(1 + 2⁻²¹), taken before dividing:
 /// wide enough never to drop a hit whose computed t = T/det lies below t_max (the two
 /// roundings of the product and the one of the quotient stay within 2⁻²³; a subnormal
 /// product is met by ≤), so that the hit is decided by t < t_max alone. With the strict
@@ -268,7 +268,10 @@ fn finish(
 /// float nearer than the best hit could fail it, and which of two nearly tied triangles a
 /// closest-hit query kept then depended on the order it met them in
 /// (`flat::tests::the_nearest_hit_wins_whatever_the_order`).
-pub(super) const PRECHECK_SLACK: f32 = 1.0 + 1.0 / (1 << 21) as f32;
+#[inline(always)]
+pub(super) fn cut_bound<T: BoundArithmetic>(t_max: T, det_p: T) -> T {
+    t_max * det_p * T::splat(1.0 + 1.0 / (1 << 21) as f32)
+}
 
 /// Accepts the candidate: t = T/det within (0, t_max). The sign of t is certain when T
 /// exceeds its rounding error bound (`error_bound()`, evaluated only for candidates);
@@ -289,7 +292,7 @@ pub(super) fn hit_from(
     } else {
         (t_num, det)
     };
-    if !(t_num_p > 0.0 && t_num_p <= t_max * det_p * PRECHECK_SLACK) {
+    if !(t_num_p > 0.0 && t_num_p <= cut_bound(t_max, det_p)) {
         return None;
     }
     if t_num_p <= error_bound() && !t_is_positive(tri, r) {
