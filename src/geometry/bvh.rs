@@ -19,7 +19,6 @@ use obvhs::{
     BvhBuildParams,
     aabb::Aabb,
     bvh2::reinsertion::ReinsertionOptimizer,
-    cwbvh::node::CwBvhNode,
     ploc::{PlocBuilder, PlocSearchDistance},
 };
 use rayon::prelude::*;
@@ -30,9 +29,9 @@ pub use stream::IN_FLIGHT;
 
 use super::cwbvh;
 use super::flat::{FLAT_LIMIT, FlatTriangles, LANE_LEAVES_LIMIT};
-use super::offset::gamma;
 use super::packet::{PACKET_LIMIT, PacketTriangles};
 use super::triangle::{TriangleHit, TriangleRay, TriangleRecord};
+use super::wide_node::WideNode;
 
 /// Binary BVH settings for `n` triangles: obvhs's `fast_build` preset (PLOC with a short
 /// search radius and a little reinsertion), with the shortest radius (1, obvhs's fast path)
@@ -61,7 +60,7 @@ pub struct TraversalRay {
     pub o: Vec3A,
     pub d: Vec3A,
     pub inv_d: Vec3A,
-    /// Byte offsets in a `CwBvhNode` of the near and far child planes along x, y, z.
+    /// Rows of `WideNode::planes` holding the near and far planes along x, y, z.
     near: [usize; 3],
     far: [usize; 3],
     /// Child-order key of the ray's octant, as obvhs's builder expects it.
@@ -69,59 +68,45 @@ pub struct TraversalRay {
     pub tri: TriangleRay,
 }
 
-// The near/far plane selection below relies on each axis' max planes following its min
-// planes.
-const _: () = {
-    assert!(
-        std::mem::offset_of!(CwBvhNode, child_max_x)
-            == std::mem::offset_of!(CwBvhNode, child_min_x) + 8
-    );
-    assert!(
-        std::mem::offset_of!(CwBvhNode, child_max_y)
-            == std::mem::offset_of!(CwBvhNode, child_min_y) + 8
-    );
-    assert!(
-        std::mem::offset_of!(CwBvhNode, child_max_z)
-            == std::mem::offset_of!(CwBvhNode, child_min_z) + 8
-    );
-};
-
 impl TraversalRay {
     /// `d` must be finite and non-zero (`Geometry` scales it so that its largest component
     /// is in [1, 2)).
     #[inline(always)]
     pub fn new(o: Vec3, d: Vec3) -> Self {
-        // A zero (or tiny) component would give an infinite reciprocal and NaN slab
-        // distances (0·∞); 1e-18 keeps them finite, and the resulting tilt (≤ 1e-18 per
-        // unit of t) is far below f32 resolution at any scene scale.
+        // A zero component gets an infinite reciprocal (1/±0 = ±∞): the exact slab of a
+        // ray parallel to the planes (`WideNode::hitmask` reads 0·∞ = NaN, a ray starting on
+        // such a plane, as no constraint). Arithmetic instead of branches (directions are
+        // random): a negative component swaps the axis' near and far planes and clears its
+        // octant bit; signs from the sign bits, so that −0 goes with its reciprocal −∞.
         let d3 = Vec3A::from(d);
-        let tiny = d3.abs().cmplt(Vec3A::splat(1e-18));
-        let dc = Vec3A::select(tiny, Vec3A::splat(1e-18).copysign(d3), d3);
-        // Arithmetic instead of branches (directions are random): a negative component
-        // swaps the axis' near and far planes, and clears its octant bit.
-        // Signs from the clamped components: a −0 component became −1e-18, and the plane
-        // choice must agree with the sign of its reciprocal.
-        let neg_bits = dc.cmplt(Vec3A::ZERO).bitmask();
+        let neg_bits = d3.is_negative_bitmask();
         let neg = [0, 1, 2].map(|k| ((neg_bits >> k) & 1) as usize);
-        let min = [
-            std::mem::offset_of!(CwBvhNode, child_min_x),
-            std::mem::offset_of!(CwBvhNode, child_min_y),
-            std::mem::offset_of!(CwBvhNode, child_min_z),
-        ];
-        let near = [0, 1, 2].map(|k| min[k] + 8 * neg[k]);
-        let far = [0, 1, 2].map(|k| min[k] + 8 * (1 - neg[k]));
+        let near = [0, 1, 2].map(|k| 2 * k + neg[k]);
+        let far = [0, 1, 2].map(|k| 2 * k + 1 - neg[k]);
         let oct_inv4 = ((1 - neg[0] as u32) * 0x0404_0404)
             | ((1 - neg[1] as u32) * 0x0202_0202)
             | ((1 - neg[2] as u32) * 0x0101_0101);
         TraversalRay {
             o: o.into(),
             d: d3,
-            inv_d: dc.recip(),
+            inv_d: d3.recip(),
             near,
             far,
             oct_inv4,
             tri: TriangleRay::new(o, d),
         }
+    }
+
+    /// The rows of `WideNode::planes` with the near and far plane along each axis.
+    #[inline(always)]
+    pub fn plane_rows(&self) -> ([usize; 3], [usize; 3]) {
+        (self.near, self.far)
+    }
+
+    /// The ray's octant as the child order expects it (bits 2, 1, 0 set for x, y, z ≥ 0).
+    #[inline(always)]
+    pub fn octant(&self) -> u32 {
+        self.oct_inv4 & 0xff
     }
 }
 
@@ -143,7 +128,7 @@ pub trait TriangleSource: Sync {
 
 /// The BVH and the triangles in its leaf order.
 pub struct TriangleBvh {
-    nodes: Vec<CwBvhNode>,
+    nodes: Vec<WideNode>,
     records: Vec<TriangleRecord>,
     /// Vertex normals per record (zero when the mesh has none), if any mesh has them.
     normals: Option<Vec<[Vec3; 3]>>,
@@ -222,7 +207,7 @@ impl TriangleBvh {
         let nodes = if records.len() <= flat_limit {
             Vec::new()
         } else {
-            collect_large(wide.nodes.par_iter().copied())
+            collect_large(wide.nodes.par_iter().map(WideNode::decode))
         };
         // Sixteen-ray queries test every triangle in lanes on a flat scene, and on a small
         // tree when enough lanes are active (`Geometry::packet_pays`).
@@ -292,6 +277,11 @@ impl TriangleBvh {
     pub fn uvs(&self, index: u32) -> Option<&[Vec2; 3]> {
         let uv = &self.uvs.as_ref()?[index as usize];
         (!uv[0].is_nan()).then_some(uv)
+    }
+
+    /// The tree's nodes, root first; empty for a scene answered without the tree.
+    pub fn wide_nodes(&self) -> &[WideNode] {
+        &self.nodes
     }
 
     /// Number of wide nodes; 0 for a scene answered without the tree (`is_flat`).
@@ -374,13 +364,32 @@ impl TriangleBvh {
             return false;
         }
         let mut t_max = t_max;
+        let pad = self.hit_pad(ray);
         if self.depth < FIXED_STACK {
             let mut stack = FixedStack::<FIXED_STACK>::new();
-            self.traverse(ray, &mut t_max, &mut stack, visitor)
+            self.traverse(ray, &mut t_max, pad, &mut stack, visitor)
         } else {
             let mut stack = Vec::with_capacity(self.depth + 1);
-            self.traverse(ray, &mut t_max, &mut stack, visitor)
+            self.traverse(ray, &mut t_max, pad, &mut stack, visitor)
         }
+    }
+
+    /// How far beyond a segment's end the boxes are tested (`traverse`), in units of t.
+    ///
+    /// The box test keeps every box the exact segment (0, t_max) meets (`WideNode`), but
+    /// the triangle test reports computed distances: a triangle whose computed t lies
+    /// just below t_max can have its exact t above it, and its box would be dropped
+    /// (it happened: the Cornell box's floor and a block's bottom face one float apart).
+    /// The triangle test's error grows with the coordinates it subtracts the origin from
+    /// (`triangle::t_num_error_bound`: a few units of roundoff times the largest |v − o|,
+    /// over |d| for t), so the boxes are tested up to 2⁻¹² of the largest distance from the
+    /// origin to the scene's box beyond t_max: hundreds of times that error for any
+    /// triangle that is not a sliver, and the price is a few boxes just past the hit.
+    #[inline(always)]
+    fn hit_pad(&self, ray: &TraversalRay) -> f32 {
+        let (lo, hi) = (Vec3A::from(self.bounds.0), Vec3A::from(self.bounds.1));
+        let reach = (lo - ray.o).abs().max((hi - ray.o).abs()).max_element();
+        reach * (1.0 / 4096.0) / ray.d.abs().max_element()
     }
 
     /// Walks the BVH front to back (Ylitie et al. 2017, Algorithm 1: node groups hold the
@@ -392,6 +401,7 @@ impl TriangleBvh {
         &self,
         ray: &TraversalRay,
         t_max: &mut f32,
+        pad: f32,
         stack: &mut S,
         visitor: &mut impl Visitor,
     ) -> bool {
@@ -410,12 +420,9 @@ impl TriangleBvh {
                 let slot = (bit - 24) ^ oct;
                 let rank = (hits & !(u32::MAX << slot)).count_ones();
                 let node = &self.nodes[(node_group.x + rank) as usize];
-                let hitmask = node_hitmask(node, ray, *t_max);
-                node_group = uvec2(
-                    node.child_base_idx,
-                    (hitmask & 0xff00_0000) | node.imask as u32,
-                );
-                tri_group = uvec2(node.primitive_base_idx, hitmask & 0x00ff_ffff);
+                let hitmask = node.hitmask(ray, *t_max + pad);
+                node_group = uvec2(node.child_base, (hitmask & 0xff00_0000) | node.imask as u32);
+                tri_group = uvec2(node.primitive_base, hitmask & 0x00ff_ffff);
                 self.prefetch_children::<false>(node, hitmask, oct);
             } else {
                 node_group = UVec2::ZERO;
@@ -443,22 +450,25 @@ impl TriangleBvh {
     /// prefetch to help (measured: 2% slower with it on the 100k scene); the stream tests
     /// them a step later.
     #[inline(always)]
-    fn prefetch_children<const TRIANGLES: bool>(&self, node: &CwBvhNode, hitmask: u32, oct: u32) {
+    fn prefetch_children<const TRIANGLES: bool>(&self, node: &WideNode, hitmask: u32, oct: u32) {
         let mut internal = hitmask >> 24;
         while internal != 0 {
             let slot = internal.trailing_zeros() ^ oct;
             internal &= internal - 1;
             let rank = (node.imask as u32 & !(u32::MAX << slot)).count_ones();
-            if let Some(child) = self.nodes.get((node.child_base_idx + rank) as usize) {
-                prefetch(child);
-                prefetch(&child.child_max_z); // the node's second cache line
+            if let Some(child) = self.nodes.get((node.child_base + rank) as usize) {
+                // The node's four cache lines.
+                let start = child as *const WideNode as usize;
+                for line in 0..4 {
+                    prefetch_address(start + 64 * line);
+                }
             }
         }
         let tris = hitmask & 0x00ff_ffff;
         if TRIANGLES && tris != 0 {
             // The hit leaves' triangles are contiguous: their first and last lines.
-            let first = node.primitive_base_idx + tris.trailing_zeros();
-            let last = node.primitive_base_idx + 31 - tris.leading_zeros();
+            let first = node.primitive_base + tris.trailing_zeros();
+            let last = node.primitive_base + 31 - tris.leading_zeros();
             if let Some(run) = self.records.get(first as usize..=last as usize) {
                 // Every cache line of the run, not just its ends (leaves of several nodes'
                 // worth of triangles span several lines); at most 8 lines.
@@ -726,172 +736,9 @@ impl TraversalStack for Vec<UVec2> {
     }
 }
 
-/// Per-node slab constants. A child plane with quantised coordinate q lies at
-/// x = p + q·e (e a power of two), at ray distance t = q·a + b with a = e/d and
-/// b = (p − o)/d. Rounding: 1/d (one rounding), p − o and the product (two), q·a (exact e,
-/// one), the fused sum (one): |Δt| ≤ γ(4)·(|b| + q|a|) ≤ γ(4)·(|b| + 255|a|). The boxes
-/// themselves are exact (`cwbvh.rs` quantises outward in f64). `margin` =
-/// γ(8)·(|b| + 256|a|) covers the rounding twice over; near planes move nearer by it, far
-/// planes farther.
-#[inline(always)]
-fn slab_constants(node: &CwBvhNode, ray: &TraversalRay) -> (Vec3A, Vec3A, Vec3A) {
-    let e = Vec3A::new(
-        f32::from_bits((node.e[0] as u32) << 23),
-        f32::from_bits((node.e[1] as u32) << 23),
-        f32::from_bits((node.e[2] as u32) << 23),
-    );
-    let a = e * ray.inv_d;
-    let b = (Vec3A::from(node.p) - ray.o) * ray.inv_d;
-    let margin = (b.abs() + a.abs() * 256.0) * gamma(8);
-    (a, b - margin, b + margin)
-}
-
-/// Which children of `node` the ray's segment (0, t_max) meets, as the traversal's hit mask:
-/// internal children set bit 24 + (slot ^ octant), leaves set their triangles' bits.
-/// Branch-free: the slab test and the mask assembly run on all 8 children at once.
-#[cfg(all(
-    target_arch = "x86_64",
-    target_feature = "avx2",
-    target_feature = "fma"
-))]
-#[inline(always)]
-fn node_hitmask(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
-    use std::arch::x86_64::*;
-    let (a, near_b, far_b) = slab_constants(node, ray);
-    // SAFETY: AVX2 and FMA are enabled for this build (cfg above); the loads read 8 bytes
-    // at field offsets inside `*node` (80 bytes, repr(C)).
-    unsafe {
-        let base = node as *const CwBvhNode as *const u8;
-        let bytes = |offset: usize| {
-            _mm256_cvtepu8_epi32(_mm_loadl_epi64(base.add(offset) as *const __m128i))
-        };
-        let load = |offset: usize| _mm256_cvtepi32_ps(bytes(offset));
-        let t_near = |k: usize, a: f32, b: f32| {
-            _mm256_fmadd_ps(load(ray.near[k]), _mm256_set1_ps(a), _mm256_set1_ps(b))
-        };
-        let t_far = |k: usize, a: f32, b: f32| {
-            _mm256_fmadd_ps(load(ray.far[k]), _mm256_set1_ps(a), _mm256_set1_ps(b))
-        };
-        let t_enter = _mm256_max_ps(
-            _mm256_max_ps(t_near(0, a.x, near_b.x), t_near(1, a.y, near_b.y)),
-            _mm256_max_ps(t_near(2, a.z, near_b.z), _mm256_setzero_ps()),
-        );
-        let t_exit = _mm256_min_ps(
-            _mm256_min_ps(t_far(0, a.x, far_b.x), t_far(1, a.y, far_b.y)),
-            _mm256_min_ps(t_far(2, a.z, far_b.z), _mm256_set1_ps(t_max)),
-        );
-        let hit = _mm256_castps_si256(_mm256_cmp_ps::<_CMP_LE_OQ>(t_enter, t_exit));
-        // Each child's meta byte m: a leaf sets its triangle count (unary, m >> 5) of bits
-        // from its first triangle's offset (m & 31); an internal child (m = 0b001_11sss for
-        // slot s) sets one bit (m >> 5 = 1) at 24 + (s ^ octant) = (m ^ octant) & 31; an
-        // empty slot (m = 0) sets none.
-        let m = bytes(std::mem::offset_of!(CwBvhNode, child_meta));
-        let set1 = _mm256_set1_epi32;
-        let inner = _mm256_cmpeq_epi32(_mm256_and_si256(m, set1(0x18)), set1(0x18));
-        let octant = _mm256_and_si256(inner, set1((ray.oct_inv4 & 0xff) as i32));
-        let index = _mm256_and_si256(_mm256_xor_si256(m, octant), set1(0x1f));
-        let bits = _mm256_and_si256(_mm256_srli_epi32::<5>(m), set1(7));
-        let v = _mm256_and_si256(_mm256_sllv_epi32(bits, index), hit);
-        let v = _mm_or_si128(_mm256_castsi256_si128(v), _mm256_extracti128_si256::<1>(v));
-        let v = _mm_or_si128(v, _mm_shuffle_epi32::<0b01_00_11_10>(v));
-        let v = _mm_or_si128(v, _mm_shuffle_epi32::<0b10_11_00_01>(v));
-        _mm_cvtsi128_si32(v) as u32
-    }
-}
-
-#[cfg(not(all(
-    target_arch = "x86_64",
-    target_feature = "avx2",
-    target_feature = "fma"
-)))]
-#[inline(always)]
-fn node_hitmask(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
-    node_hitmask_scalar(node, ray, t_max)
-}
-
-/// Portable version of `node_hitmask` (also the reference for the SIMD one in tests).
-pub fn node_hitmask_scalar(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
-    let mask = child_mask_scalar(node, ray, t_max);
-    let (child_bits8, bit_index8) = node.get_child_and_index_bits(ray.oct_inv4);
-    let mut m = mask;
-    let mut hitmask = 0;
-    while m != 0 {
-        let j = m.trailing_zeros() * 8;
-        let child_bits = ((child_bits8 >> j) as u32) & 0xff;
-        let bit_index = ((bit_index8 >> j) as u32) & 0xff;
-        hitmask |= child_bits << bit_index;
-        m &= m - 1;
-    }
-    hitmask
-}
-
-/// Bit c set when child slot c's box meets the segment (empty slots may be set; their
-/// child bits are zero).
-#[inline(always)]
-pub fn child_mask_scalar(node: &CwBvhNode, ray: &TraversalRay, t_max: f32) -> u32 {
-    let (a, near_b, far_b) = slab_constants(node, ray);
-    // SAFETY: the offsets are those of the six [u8; 8] plane arrays inside `*node`.
-    let planes = |offset: usize| unsafe {
-        *((node as *const CwBvhNode as *const u8).add(offset) as *const [u8; 8])
-    };
-    let near = [
-        planes(ray.near[0]),
-        planes(ray.near[1]),
-        planes(ray.near[2]),
-    ];
-    let far = [planes(ray.far[0]), planes(ray.far[1]), planes(ray.far[2])];
-    let mut mask = 0;
-    for c in 0..8 {
-        let mut t_enter = 0.0f32;
-        let mut t_exit = t_max;
-        for k in 0..3 {
-            t_enter = t_enter.max((near[k][c] as f32).mul_add(a[k], near_b[k]));
-            t_exit = t_exit.min((far[k][c] as f32).mul_add(a[k], far_b[k]));
-        }
-        if t_enter <= t_exit {
-            mask |= 1 << c;
-        }
-    }
-    mask
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn simd_node_hitmask_matches_scalar() {
-        let mut s = 12345u64;
-        let mut next = || {
-            s ^= s << 13;
-            s ^= s >> 7;
-            s ^= s << 17;
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
-        let mut tris = Vec::new();
-        for _ in 0..2000 {
-            let c = Vec3::new(next(), next(), next()) * 10.0;
-            let v = |c: Vec3, f: &mut dyn FnMut() -> f32| c + Vec3::new(f(), f(), f()) * 0.5;
-            tris.push([v(c, &mut next), v(c, &mut next), v(c, &mut next)]);
-        }
-        let ids: Vec<[u32; 2]> = (0..tris.len() as u32).map(|i| [0, i]).collect();
-        let bvh = TriangleBvh::build(&TriangleList {
-            vertices: &tris,
-            ids: &ids,
-        });
-        for _ in 0..2000 {
-            let o = Vec3::new(next(), next(), next()) * 12.0 - 1.0;
-            let d = (Vec3::new(next(), next(), next()) - 0.5).normalize();
-            let r = TraversalRay::new(o, d);
-            for node in &bvh.nodes {
-                let t_max = next() * 20.0;
-                assert_eq!(
-                    node_hitmask(node, &r, t_max),
-                    node_hitmask_scalar(node, &r, t_max)
-                );
-            }
-        }
-    }
 
     #[test]
     fn axis_aligned_rays_with_signed_zeros_hit() {

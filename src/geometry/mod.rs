@@ -8,7 +8,8 @@
 //!   conservative traversal (closest hit and any hit).
 //! - `bvh/stream.rs`: closest hits for a slice of rays with several traversals in flight
 //!   (`Geometry::intersect_stream`), for scenes too large for the cache.
-//! - `cwbvh.rs`: collapsing obvhs's binary BVH into the 8-wide one.
+//! - `cwbvh.rs`: collapsing obvhs's binary BVH into the 8-wide one (compressed boxes).
+//! - `wide_node.rs`: the node traversal reads, its boxes decoded to f32, and its ray test.
 //! - `flat.rs`: small scenes answered without the tree, sixteen triangles per test.
 //! - `packet.rs`: sixteen rays at a time on those small scenes (and on trees of at most
 //!   `PACKET_LIMIT` triangles when enough lanes are active), one triangle per test.
@@ -40,6 +41,7 @@ pub mod packet;
 pub mod procedural;
 pub mod sphere;
 pub mod triangle;
+pub mod wide_node;
 
 use glam::{Vec2, Vec3};
 

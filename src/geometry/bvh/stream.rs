@@ -15,8 +15,8 @@
 use glam::{UVec2, uvec2};
 
 use super::{
-    FIXED_STACK, FixedStack, TraversalRay, TraversalStack, TriangleBvh, node_hitmask, prefetch,
-    replaces, tie_limit,
+    FIXED_STACK, FixedStack, TraversalRay, TraversalStack, TriangleBvh, prefetch, replaces,
+    tie_limit,
 };
 use crate::geometry::triangle::{self, TriangleHit};
 
@@ -137,12 +137,9 @@ impl TriangleBvh {
         let slot = (bit - 24) ^ oct;
         let rank = (hits & !(u32::MAX << slot)).count_ones();
         let node = &self.nodes[(s.node_group.x + rank) as usize];
-        let hitmask = node_hitmask(node, ray, s.t_max);
-        s.node_group = uvec2(
-            node.child_base_idx,
-            (hitmask & 0xff00_0000) | node.imask as u32,
-        );
-        s.tri_group = uvec2(node.primitive_base_idx, hitmask & 0x00ff_ffff);
+        let hitmask = node.hitmask(ray, s.t_max + self.hit_pad(ray));
+        s.node_group = uvec2(node.child_base, (hitmask & 0xff00_0000) | node.imask as u32);
+        s.tri_group = uvec2(node.primitive_base, hitmask & 0x00ff_ffff);
         self.prefetch_children::<true>(node, hitmask, oct);
         true
     }
