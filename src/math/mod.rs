@@ -1,5 +1,6 @@
 //! Small math vocabulary shared by every part of mltbench.
 
+pub mod erf;
 pub mod fast_trig;
 pub mod frame;
 pub mod lanes;
