@@ -41,6 +41,19 @@ impl WrapMode {
         };
         inside as usize
     }
+
+    /// `wrap` of texel indices `i` and `i + 1`, with one division where the mode allows
+    /// (a bilinear lookup wraps two neighbours per axis).
+    #[inline]
+    fn wrap_pair(self, i: i64, n: i64) -> (usize, usize) {
+        match self {
+            WrapMode::Repeat => {
+                let a = i.rem_euclid(n);
+                (a as usize, if a + 1 == n { 0 } else { a as usize + 1 })
+            }
+            _ => (self.wrap(i, n), self.wrap(i + 1, n)),
+        }
+    }
 }
 
 /// Linear RGB texels, row 0 at the top, with the lookup's settings.
@@ -79,9 +92,11 @@ impl Bitmap {
                 let (x, y) = (x - 0.5, y - 0.5);
                 let (x0, y0) = (x.floor(), y.floor());
                 let (fx, fy) = ((x - x0) as f32, (y - y0) as f32);
-                let (x0, y0) = (x0 as i64, y0 as i64);
-                let top = self.texel(x0, y0) * (1.0 - fx) + self.texel(x0 + 1, y0) * fx;
-                let bottom = self.texel(x0, y0 + 1) * (1.0 - fx) + self.texel(x0 + 1, y0 + 1) * fx;
+                let (x0, x1) = self.wrap.wrap_pair(x0 as i64, self.width as i64);
+                let (y0, y1) = self.wrap.wrap_pair(y0 as i64, self.height as i64);
+                let at = |x: usize, y: usize| self.texels[y * self.width as usize + x];
+                let top = at(x0, y0) * (1.0 - fx) + at(x1, y0) * fx;
+                let bottom = at(x0, y1) * (1.0 - fx) + at(x1, y1) * fx;
                 top * (1.0 - fy) + bottom * fy
             }
         }
@@ -146,6 +161,23 @@ mod tests {
             assert!((at(&b, 0.5, 0.5) - 2.5).abs() < 1e-6);
             // A quarter of the way from texel 1's centre to texel 2's.
             assert!((at(&b, 0.375, 0.25) - 1.25).abs() < 1e-6);
+        }
+    }
+
+    /// The pair a bilinear lookup wraps is each index wrapped on its own.
+    #[test]
+    fn wrapped_pairs_are_wrapped_indices() {
+        for mode in [WrapMode::Repeat, WrapMode::Mirror, WrapMode::Clamp] {
+            for n in [1i64, 2, 3, 7, 64] {
+                for i in -4 * n..4 * n {
+                    let pair = mode.wrap_pair(i, n);
+                    assert_eq!(
+                        pair,
+                        (mode.wrap(i, n), mode.wrap(i + 1, n)),
+                        "{mode:?} {i} {n}"
+                    );
+                }
+            }
         }
     }
 
