@@ -45,14 +45,7 @@ impl WideNode {
     /// The node of compressed node `node`, its planes p + q·2^e computed exactly in f64
     /// and rounded outward to f32.
     pub fn decode(node: &CwBvhNode) -> WideNode {
-        let q = [
-            node.child_min_x,
-            node.child_max_x,
-            node.child_min_y,
-            node.child_max_y,
-            node.child_min_z,
-            node.child_max_z,
-        ];
+        let q = quantised_rows(node);
         let planes = std::array::from_fn(|row| {
             let k = row / 2;
             let scale = f32::from_bits((node.e[k] as u32) << 23) as f64;
@@ -161,6 +154,18 @@ impl WideNode {
             _mm_cvtsi128_si32(v) as u32
         }
     }
+}
+
+/// A compressed node's 8-bit planes in `WideNode::planes`' row order.
+fn quantised_rows(node: &CwBvhNode) -> [[u8; 8]; 6] {
+    [
+        node.child_min_x,
+        node.child_max_x,
+        node.child_min_y,
+        node.child_max_y,
+        node.child_min_z,
+        node.child_max_z,
+    ]
 }
 
 /// What a hit child adds to the hit mask, from its meta byte m: a leaf sets its triangle
@@ -284,14 +289,7 @@ mod tests {
             (node.child_min_y, node.child_max_y) = (bytes(), bytes());
             (node.child_min_z, node.child_max_z) = (bytes(), bytes());
             let wide = WideNode::decode(&node);
-            let q = [
-                node.child_min_x,
-                node.child_max_x,
-                node.child_min_y,
-                node.child_max_y,
-                node.child_min_z,
-                node.child_max_z,
-            ];
+            let q = quantised_rows(&node);
             for (row, (q_row, planes)) in q.iter().zip(&wide.planes).enumerate() {
                 let k = row / 2;
                 let scale = 2f64.powi(node.e[k] as i32 - 127);
