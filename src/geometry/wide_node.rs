@@ -8,7 +8,7 @@
 //! decoded once, at build time, into f32 planes rounded outward, so the ray test is a
 //! subtraction and a multiplication per plane (the layout of a wide node in Embree, Wald et
 //! al. 2014). Measured on the development machine (`pt`, 2 threads): water +9%, 11.5k
-//! triangles +6%, 330k triangles unchanged; docs/performance.md has the figures.
+//! triangles +11%, 330k triangles unchanged; docs/performance.md has the figures.
 //!
 //! Each node takes four cache lines (the compressed one 80 bytes): what it saves is
 //! latency, which matters while a tree fits in the caches.
