@@ -35,17 +35,20 @@ struct Traversal {
     tri_group: UVec2,
     stack: FixedStack<FIXED_STACK>,
     t_max: f32,
+    /// How far beyond `t_max` boxes are tested (`TriangleBvh::hit_pad`).
+    pad: f32,
     best: Option<(u32, TriangleHit)>,
 }
 
 impl Traversal {
-    fn start(ray: usize, t_max: f32) -> Self {
+    fn start(bvh: &TriangleBvh, rays: &[TraversalRay], ray: usize, t_max: f32) -> Self {
         Traversal {
             ray,
             node_group: uvec2(0, 0x8000_0000),
             tri_group: UVec2::ZERO,
             stack: FixedStack::new(),
             t_max,
+            pad: bvh.hit_pad(&rays[ray]),
             best: None,
         }
     }
@@ -74,7 +77,7 @@ impl TriangleBvh {
         let mut active = 0;
         for slot in &mut slots {
             if next < rays.len() {
-                *slot = Some(Traversal::start(next, t_max[next]));
+                *slot = Some(Traversal::start(self, rays, next, t_max[next]));
                 next += 1;
                 active += 1;
             }
@@ -87,7 +90,7 @@ impl TriangleBvh {
                 }
                 done(traversal.ray, traversal.best);
                 if next < rays.len() {
-                    *traversal = Traversal::start(next, t_max[next]);
+                    *traversal = Traversal::start(self, rays, next, t_max[next]);
                     next += 1;
                 } else {
                     *slot = None;
@@ -137,7 +140,7 @@ impl TriangleBvh {
         let slot = (bit - 24) ^ oct;
         let rank = (hits & !(u32::MAX << slot)).count_ones();
         let node = &self.nodes[(s.node_group.x + rank) as usize];
-        let hitmask = node.hitmask(ray, s.t_max + self.hit_pad(ray));
+        let hitmask = node.hitmask(ray, s.t_max + s.pad);
         s.node_group = uvec2(node.child_base, (hitmask & 0xff00_0000) | node.imask as u32);
         s.tri_group = uvec2(node.primitive_base, hitmask & 0x00ff_ffff);
         self.prefetch_children::<true>(node, hitmask, oct);
