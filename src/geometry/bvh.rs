@@ -1,14 +1,17 @@
-//! All triangles of a scene in one compressed 8-wide BVH (Ylitie, Karras & Laine,
-//! "Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide BVHs", HPG 2017):
-//! obvhs builds a binary BVH (PLOC + reinsertion, in parallel), `cwbvh.rs` collapses it
-//! into obvhs's `CwBvhNode` layout.
+//! All triangles of a scene in one 8-wide BVH: obvhs builds a binary BVH (PLOC +
+//! reinsertion, in parallel), `cwbvh.rs` collapses it into the compressed layout of Ylitie,
+//! Karras & Laine ("Efficient Incoherent Ray Traversal on GPUs Through Compressed Wide
+//! BVHs", HPG 2017), and each node is then decoded into the f32 boxes traversal reads
+//! (`wide_node.rs`).
 //!
 //! The traversal is mltbench's own, so that it can be conservative: obvhs's node test
 //! drops boxes closer than t = 1e-4 and has no rounding slack, which loses hits near ray
-//! origins and lets rays slip past box faces. Here each slab distance is widened by a bound
-//! on its rounding error, so a triangle that the exact ray meets is never culled by a box
-//! test; the triangle test is watertight (`triangle.rs`). Triangle data are stored in the
-//! BVH's leaf order: a leaf's triangles are contiguous and need no index indirection.
+//! origins and lets rays slip past box faces. Here the box test allows for its own rounding
+//! (`WideNode::hitmask`) and boxes are tested a little beyond the segment's end
+//! (`hit_pad`, for the triangle test's rounding), so a triangle the triangle test would
+//! report is never culled by a box; the triangle test is watertight (`triangle.rs`).
+//! Triangle data are stored in the BVH's leaf order: a leaf's triangles are contiguous and
+//! need no index indirection.
 //!
 //! Measured on the development machine (2-core AMD EPYC, AVX2): obvhs's CWBVH traversal ran
 //! 1.5–2.5× faster than its binary BVH traversal with the same triangle test, so only the
