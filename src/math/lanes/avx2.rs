@@ -181,6 +181,31 @@ fn low_words(v: __m256i) -> __m128i {
 
 const SIGN: u32 = 0x8000_0000;
 
+/// For each 8-bit mask, the lanes it selects in order (then zeros): the permutation that packs
+/// those lanes at the front of a half (`compress_store`).
+static COMPRESS: [[u32; 8]; 256] = {
+    let mut table = [[0u32; 8]; 256];
+    let mut bits = 0;
+    while bits < 256 {
+        let (mut lane, mut k) = (0, 0);
+        while lane < 8 {
+            if bits & (1 << lane) != 0 {
+                table[bits][k] = lane as u32;
+                k += 1;
+            }
+            lane += 1;
+        }
+        bits += 1;
+    }
+    table
+};
+
+/// `COMPRESS[bits]` in a register.
+#[inline(always)]
+fn compress_index(bits: u8) -> __m256i {
+    unsafe { _mm256_loadu_si256(COMPRESS[bits as usize].as_ptr() as *const __m256i) }
+}
+
 impl Neg for F32x16 {
     type Output = F32x16;
     #[inline(always)]
@@ -356,14 +381,17 @@ impl F32x16 {
         }
     }
 
-    /// Stores the lanes of `m`, in lane order, at the start of `dst` (which must have room
-    /// for sixteen).
+    /// Stores the lanes of `m`, in lane order, at the start of `dst`, which must have room
+    /// for sixteen: the places after the stored lanes may be overwritten.
     #[inline(always)]
     pub fn compress_store(self, m: Mask16, dst: &mut [f32]) {
         assert!(dst.len() >= 16);
-        let a = self.to_array();
-        for (k, i) in m.lanes().enumerate() {
-            dst[k] = a[i];
+        let (lo, hi) = (m.0 as u8, (m.0 >> 8) as u8);
+        unsafe {
+            let at = dst.as_mut_ptr();
+            _mm256_storeu_ps(at, _mm256_permutevar8x32_ps(self.lo, compress_index(lo)));
+            let after = at.add(lo.count_ones() as usize);
+            _mm256_storeu_ps(after, _mm256_permutevar8x32_ps(self.hi, compress_index(hi)));
         }
     }
 
@@ -495,14 +523,23 @@ impl U32x16 {
         }
     }
 
-    /// Stores the lanes of `m`, in lane order, at the start of `dst` (which must have room
-    /// for sixteen).
+    /// Stores the lanes of `m`, in lane order, at the start of `dst`, which must have room
+    /// for sixteen: the places after the stored lanes may be overwritten.
     #[inline(always)]
     pub fn compress_store(self, m: Mask16, dst: &mut [u32]) {
         assert!(dst.len() >= 16);
-        let a = self.to_array();
-        for (k, i) in m.lanes().enumerate() {
-            dst[k] = a[i];
+        let (lo, hi) = (m.0 as u8, (m.0 >> 8) as u8);
+        unsafe {
+            let at = dst.as_mut_ptr() as *mut __m256i;
+            let store = |to: *mut __m256i, v: __m256i, bits: u8| {
+                _mm256_storeu_si256(to, _mm256_permutevar8x32_epi32(v, compress_index(bits)))
+            };
+            store(at, self.lo, lo);
+            store(
+                dst.as_mut_ptr().add(lo.count_ones() as usize) as *mut __m256i,
+                self.hi,
+                hi,
+            );
         }
     }
 

@@ -204,8 +204,8 @@ impl F32x16 {
         }))
     }
 
-    /// Stores the lanes of `m`, in lane order, at the start of `dst` (which must have room
-    /// for sixteen).
+    /// Stores the lanes of `m`, in lane order, at the start of `dst`, which must have room
+    /// for sixteen: the places after the stored lanes may be overwritten.
     #[inline(always)]
     pub fn compress_store(self, m: Mask16, dst: &mut [f32]) {
         assert!(dst.len() >= 16);
@@ -280,8 +280,8 @@ impl U32x16 {
         U32x16(self.0.map(|a| a >> N))
     }
 
-    /// Stores the lanes of `m`, in lane order, at the start of `dst` (which must have room
-    /// for sixteen).
+    /// Stores the lanes of `m`, in lane order, at the start of `dst`, which must have room
+    /// for sixteen: the places after the stored lanes may be overwritten.
     #[inline(always)]
     pub fn compress_store(self, m: Mask16, dst: &mut [u32]) {
         assert!(dst.len() >= 16);
