@@ -940,6 +940,16 @@ fn packet_queries_match_single_ray_queries() {
                     Some(si) => si.spawn_ray(rng.direction()),
                     None => Ray::new(o, rng.direction()),
                 },
+                // Along a plane through a vertex (a direction component of zero, the
+                // origin on a face of the boxes around the records): the boxes that skip
+                // records (`packet_boxes.rs`) must keep the triangles in that plane.
+                3 if i % 8 == 7 => {
+                    let v = vertices[rng.below(vertices.len())];
+                    let k = rng.below(3);
+                    let (mut o, mut d) = (o, rng.direction());
+                    (o[k], d[k]) = (v[k], 0.0);
+                    Ray::new(o, d)
+                }
                 _ => Ray::new(o, rng.direction()),
             };
             if i % 7 == 0 {

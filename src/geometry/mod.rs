@@ -38,6 +38,7 @@ pub mod disk;
 pub mod flat;
 pub mod offset;
 pub mod packet;
+mod packet_boxes;
 pub mod procedural;
 pub mod sphere;
 pub mod triangle;

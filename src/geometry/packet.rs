@@ -9,6 +9,8 @@
 //! report for its ray: a lane whose edge functions are all non-zero and whose T exceeds its
 //! rounding error bound is settled from its own values; any other candidate goes through
 //! `triangle::intersect` itself. `tests/geometry.rs` compares both queries ray by ray.
+//! Runs of four records share a box (`packet_boxes.rs`): lanes whose segment misses it skip
+//! the run's four tests, and a run no lane meets costs one slab test instead of four.
 //!
 //! The analytic shapes of a small scene come first, as in the per-ray queries: spheres and
 //! disks in f64 lanes (`Sphere::intersect_lanes`, `Disk::intersect_lanes`: the same
@@ -20,6 +22,7 @@
 
 use super::bvh::TraversalRay;
 use super::offset::gamma;
+use super::packet_boxes::{BoxRays, RUN, RunBoxes};
 use super::sphere;
 use super::triangle::{self, BoundArithmetic, TriangleHit, TriangleRay, TriangleRecord};
 use super::{ClosestHit, Geometry, Hit, Ray, ScaledRay};
@@ -107,6 +110,8 @@ pub struct PacketTriangles {
     triangles: Vec<PacketTriangle>,
     /// With `BY_VERTEX`, per record: vertex j's coordinates in lanes 0–2 of vector j.
     by_vertex: Vec<[PacketTriangle; 3]>,
+    /// Boxes around runs of records, tested before the records (`packet_boxes.rs`).
+    runs: RunBoxes,
 }
 
 impl PacketTriangles {
@@ -141,10 +146,33 @@ impl PacketTriangles {
         } else {
             Vec::new()
         };
+        let runs = RunBoxes::new(records.len(), |i| {
+            let rows = &records[i].rows;
+            std::array::from_fn(|j| [rows[0][j], rows[1][j], rows[2][j]])
+        });
         PacketTriangles {
             triangles,
             by_vertex,
+            runs,
         }
+    }
+
+    /// Rays with origins `o` and directions `d` for the run boxes.
+    #[inline(always)]
+    fn box_rays(&self, o: &V3<F32x16>, d: &V3<F32x16>) -> BoxRays {
+        BoxRays::new(&self.runs, o, d)
+    }
+
+    /// The records of run `run`, with their indices.
+    #[inline(always)]
+    fn run<'r>(
+        &self,
+        records: &'r [TriangleRecord],
+        run: usize,
+    ) -> impl Iterator<Item = (usize, &'r TriangleRecord)> {
+        let first = run * RUN;
+        let end = (first + RUN).min(self.triangles.len());
+        (first..end).zip(&records[first..end])
     }
 }
 
@@ -437,10 +465,12 @@ impl PacketTriangles {
     /// For each lane of `m`: the closest record with 0 < t < t_max, as the per-triangle test
     /// finds it scanning the records in order (the first of equal t). `tri_ray(i)` is lane
     /// i's ray for that test.
+    #[allow(clippy::too_many_arguments)]
     fn closest(
         &self,
         records: &[TriangleRecord],
         r: &TriangleRayLanes,
+        boxes: &BoxRays,
         tri_ray: impl Fn(usize) -> TriangleRay,
         t_max: F32x16,
         m: Mask16,
@@ -459,38 +489,61 @@ impl PacketTriangles {
             e: [[0.0; 3]; LANES],
             det: [0.0; LANES],
         };
-        // One record per triangle, in the same order.
-        for (k, record) in records.iter().enumerate().take(self.triangles.len()) {
-            let lanes = lane_tests(self, k, r, best.t, m);
-            if lanes.candidate.none() {
+        // One record per triangle, in the same order, skipping the runs whose box no lane
+        // meets within its closest hit so far.
+        for run in 0..self.runs.len() {
+            let m = self.runs.hits(run, boxes, best.t, m);
+            if m.none() {
                 continue;
             }
-            // Only a lane that would take this hit as its closest needs the error bound; a
-            // farther one is rejected by the per-triangle test's final t < t_max anyway.
-            let t = lanes.t();
-            let closer = lanes.in_range & t.lt(best.t);
-            let settled = if closer.any() {
-                lanes.settled(closer, r)
-            } else {
-                Mask16::NONE
-            };
-            best.t = F32x16::select(settled, t, best.t);
-            best.record = U32x16::select(settled, U32x16::splat(k as u32), best.record);
-            best.hit |= settled;
-            scalar.lanes &= !settled;
-            for i in ((lanes.candidate & !lanes.in_range) | (closer & !settled)).lanes() {
-                let t_max_i = best.t.to_array()[i];
-                if let Some(h) = triangle::intersect(record, &tri_ray(i), t_max_i) {
-                    let m = Mask16(1 << i);
-                    best.t = F32x16::select(m, F32x16::splat(h.t), best.t);
-                    best.record = U32x16::select(m, U32x16::splat(k as u32), best.record);
-                    best.hit |= m;
-                    scalar.lanes |= m;
-                    (scalar.e[i], scalar.det[i]) = (h.e, h.det);
-                }
+            for (k, record) in self.run(records, run) {
+                self.closest_step(k, record, r, &tri_ray, m, best, &mut scalar);
             }
         }
         self.edges_of_best(best, &scalar, r);
+    }
+
+    /// `closest`'s test of record `k` for the lanes of `m`.
+    #[allow(clippy::too_many_arguments)]
+    #[inline(always)]
+    fn closest_step(
+        &self,
+        k: usize,
+        record: &TriangleRecord,
+        r: &TriangleRayLanes,
+        tri_ray: &impl Fn(usize) -> TriangleRay,
+        m: Mask16,
+        best: &mut BestLanes,
+        scalar: &mut ScalarHits,
+    ) {
+        let lanes = lane_tests(self, k, r, best.t, m);
+        if lanes.candidate.none() {
+            return;
+        }
+        // Only a lane that would take this hit as its closest needs the error bound; a
+        // farther one is rejected by the per-triangle test's final t < t_max anyway.
+        let t = lanes.t();
+        let closer = lanes.in_range & t.lt(best.t);
+        let settled = if closer.any() {
+            lanes.settled(closer, r)
+        } else {
+            Mask16::NONE
+        };
+        best.t = F32x16::select(settled, t, best.t);
+        best.record = U32x16::select(settled, U32x16::splat(k as u32), best.record);
+        best.hit |= settled;
+        scalar.lanes &= !settled;
+        for i in ((lanes.candidate & !lanes.in_range) | (closer & !settled)).lanes() {
+            let t_max_i = best.t.to_array()[i];
+            if let Some(h) = triangle::intersect(record, &tri_ray(i), t_max_i) {
+                let m = Mask16(1 << i);
+                best.t = F32x16::select(m, F32x16::splat(h.t), best.t);
+                best.record = U32x16::select(m, U32x16::splat(k as u32), best.record);
+                best.hit |= m;
+                scalar.lanes |= m;
+                (scalar.e[i], scalar.det[i]) = (h.e, h.det);
+            }
+        }
     }
 
     /// The edge functions and det of each lane's closest hit: recomputed from its record
@@ -519,27 +572,35 @@ impl PacketTriangles {
         &self,
         records: &[TriangleRecord],
         r: &TriangleRayLanes,
+        boxes: &BoxRays,
         tri_ray: impl Fn(usize) -> TriangleRay,
         t_max: F32x16,
         m: Mask16,
     ) -> Mask16 {
         let mut found = Mask16::NONE;
-        // One record per triangle, in the same order.
-        for (k, record) in records.iter().enumerate().take(self.triangles.len()) {
+        // Run by run, the records of the runs whose box an open lane meets.
+        for run in 0..self.runs.len() {
             let open = m & !found;
             if open.none() {
                 break;
             }
-            let lanes = lane_tests(self, k, r, t_max, open);
-            if lanes.candidate.none() {
-                continue;
-            }
-            let settled = lanes.settled(lanes.in_range, r);
-            found |= settled & lanes.t().lt(t_max);
-            for i in (lanes.candidate & !settled).lanes() {
-                let t_max_i = t_max.to_array()[i];
-                if triangle::intersect(record, &tri_ray(i), t_max_i).is_some() {
-                    found.set(i, true);
+            let open = self.runs.hits(run, boxes, t_max, open);
+            for (k, record) in self.run(records, run) {
+                let open = open & !found;
+                if open.none() {
+                    break;
+                }
+                let lanes = lane_tests(self, k, r, t_max, open);
+                if lanes.candidate.none() {
+                    continue;
+                }
+                let settled = lanes.settled(lanes.in_range, r);
+                found |= settled & lanes.t().lt(t_max);
+                for i in (lanes.candidate & !settled).lanes() {
+                    let t_max_i = t_max.to_array()[i];
+                    if triangle::intersect(record, &tri_ray(i), t_max_i).is_some() {
+                        found.set(i, true);
+                    }
                 }
             }
         }
@@ -647,9 +708,17 @@ impl Geometry {
             let s = &scaled.lanes()[i];
             TriangleRay::new(s.o, s.d)
         };
-        self.bvh
-            .packet()
-            .closest(self.bvh.records(), &tri, tri_ray, t_max, m, &mut out.best);
+        let packet = self.bvh.packet();
+        let boxes = packet.box_rays(&scaled.o, &scaled.d);
+        packet.closest(
+            self.bvh.records(),
+            &tri,
+            &boxes,
+            tri_ray,
+            t_max,
+            m,
+            &mut out.best,
+        );
         out.hit = out.best.hit | analytic;
     }
 
@@ -979,11 +1048,9 @@ impl Geometry {
             let s = &scaled.lanes()[i];
             TriangleRay::new(s.o, s.d)
         };
-        blocked
-            | self
-                .bvh
-                .packet()
-                .any(self.bvh.records(), &tri, tri_ray, scaled.t_max, m)
+        let packet = self.bvh.packet();
+        let boxes = packet.box_rays(&scaled.o, &scaled.d);
+        blocked | packet.any(self.bvh.records(), &tri, &boxes, tri_ray, scaled.t_max, m)
     }
 
     /// Whether the lanes of `m` are tested against every triangle in lanes rather than

@@ -194,7 +194,7 @@ fn hit_bits(m: u8, octant: u32) -> u32 {
 /// chains return their second operand when either is NaN, so a NaN distance drops out,
 /// together with at most one other of its chain: fewer constraints, never a missed box;
 /// the 0 and t_max that close the chains are never NaN, so neither are t_enter and t_exit.
-const EXIT_SCALE: f32 = 1.0 + 2.0 * gamma(5);
+pub(super) const EXIT_SCALE: f32 = 1.0 + 2.0 * gamma(5);
 
 /// `maxps`'s maximum: `b` when either is NaN (so a NaN first operand is ignored).
 #[inline(always)]
