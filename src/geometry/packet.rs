@@ -210,27 +210,44 @@ impl ScaledRayLanes {
         }
     }
 
-    /// Every lane as the `ScaledRay` the per-ray query makes.
-    fn lanes(&self) -> [ScaledRay; LANES] {
-        let [ox, oy, oz, dx, dy, dz, scale, inv_scale, t_max] = [
-            self.o.x,
-            self.o.y,
-            self.o.z,
-            self.d.x,
-            self.d.y,
-            self.d.z,
-            self.scale,
-            self.inv_scale,
-            self.t_max,
-        ]
-        .map(F32x16::to_array);
-        std::array::from_fn(|i| ScaledRay {
+    /// Every lane's values, from which `ScaledRayArrays::get` makes the `ScaledRay` the
+    /// per-ray query makes. (Not an array of `ScaledRay`s: the compiler writes such a
+    /// transpose with scatter instructions, microcoded on Zen 4 and slower than the queries
+    /// they feed.)
+    #[inline(always)]
+    fn lanes(&self) -> ScaledRayArrays {
+        ScaledRayArrays(
+            [
+                self.o.x,
+                self.o.y,
+                self.o.z,
+                self.d.x,
+                self.d.y,
+                self.d.z,
+                self.scale,
+                self.inv_scale,
+                self.t_max,
+            ]
+            .map(F32x16::to_array),
+        )
+    }
+}
+
+/// `ScaledRayLanes` as arrays: o, d, scale, inv_scale, t_max.
+struct ScaledRayArrays([[f32; LANES]; 9]);
+
+impl ScaledRayArrays {
+    /// Lane `i`'s `ScaledRay`.
+    #[inline(always)]
+    fn get(&self, i: usize) -> ScaledRay {
+        let [ox, oy, oz, dx, dy, dz, scale, inv_scale, t_max] = &self.0;
+        ScaledRay {
             o: glam::Vec3::new(ox[i], oy[i], oz[i]),
             d: glam::Vec3::new(dx[i], dy[i], dz[i]),
             scale: scale[i],
             inv_scale: inv_scale[i],
             t_max: t_max[i],
-        })
+        }
     }
 }
 
@@ -705,7 +722,7 @@ impl Geometry {
         let (analytic, t_max) = self.closest_analytic_lanes(&scaled, m, &mut out.analytic);
         let tri = TriangleRayLanes::new(&scaled.o, &scaled.d);
         let tri_ray = |i: usize| {
-            let s = &scaled.lanes()[i];
+            let s = scaled.lanes().get(i);
             TriangleRay::new(s.o, s.d)
         };
         let packet = self.bvh.packet();
@@ -741,7 +758,7 @@ impl Geometry {
         }
         let (t_max, scaled) = (t_max.to_array(), scaled.lanes());
         for i in m.lanes() {
-            let s = &scaled[i];
+            let s = &scaled.get(i);
             if let Some((id, hit)) = self
                 .bvh
                 .closest_in::<false>(&TraversalRay::new(s.o, s.d), t_max[i])
@@ -1034,18 +1051,18 @@ impl Geometry {
         if !self.packet_pays(m) {
             // The tree one ray at a time, for what the analytic shapes left.
             let scaled = scaled.lanes();
-            let t_max = scaled.map(|s| s.t_max);
             return blocked
                 | Mask16::from_fn(|i| {
+                    let s = scaled.get(i);
                     m.get(i)
                         && self
                             .bvh
-                            .any_in::<false>(&TraversalRay::new(scaled[i].o, scaled[i].d), t_max[i])
+                            .any_in::<false>(&TraversalRay::new(s.o, s.d), s.t_max)
                 });
         }
         let tri = TriangleRayLanes::new(&scaled.o, &scaled.d);
         let tri_ray = |i: usize| {
-            let s = &scaled.lanes()[i];
+            let s = scaled.lanes().get(i);
             TriangleRay::new(s.o, s.d)
         };
         let packet = self.bvh.packet();
