@@ -30,8 +30,10 @@ suite was not written for. Their pt / Mitsuba ratios get a geometric mean of the
 CARGO_TARGET_DIR) on this checkout's scenes, for before/after tables; the Mitsuba column
 always times this checkout's build (crosscheck_mitsuba.py). --against OLD alternates the
 build with OLD render by render (OLD, new, OLD, new, ... --repeats pairs per cell), so that a
-machine whose speed drifts moves both alike, and writes OUT/against.md: both medians and
-their ratio per cell.
+machine whose speed drifts moves both alike, and writes OUT/against.md: both medians, their
+ratio and the lowest and highest ratio of a pair per cell (a median ratio inside that range
+of 1.00 is noise). The pt / Mitsuba column likewise gives the pairs' range beside the
+median.
 
 Needs only the standard library (and a built `target/release/mltbench`).
 """
@@ -336,6 +338,8 @@ def main(argv):
                 row[label + "_error"] = error
                 if args.against and error is None:
                     row[label + "_against"] = statistics.median(old_rates)
+                    # Each pair's ratio: their spread says what a median ratio can tell.
+                    row[label + "_pair_ratios"] = [n / o for o, n in zip(old_rates, rates)]
                 print(f"{name:14} {label:8} "
                       + (f"{row[label]:.3f} M/s" if row[label] is not None else f"error: {error}")
                       + (f" (against {row[label + '_against']:.3f})" if row.get(label + "_against") else ""),
@@ -348,6 +352,7 @@ def main(argv):
                     args.repeats, lambda: mitsuba_ratio(args.mitsuba, scene, args.threads, tmp, defines))
                 if error is None:
                     row["mitsuba_ratio"] = statistics.median(p[0] for p in pairs)
+                    row["mitsuba_ratio_range"] = (min(p[0] for p in pairs), max(p[0] for p in pairs))
                     row["mitsuba_mpaths"] = statistics.median(p[2] for p in pairs)
                     row["pt_pair_mpaths"] = statistics.median(p[1] for p in pairs)
                 else:
@@ -379,7 +384,8 @@ def write_against(args, rows, labels):
         "",
         f"`perf_suite.py --repeats {args.repeats} --against {args.against} --binary {args.binary}`, "
         f"{args.threads} threads, {time.strftime('%Y-%m-%d')}: renders of the two builds taken in "
-        f"turn, medians of {args.repeats} each, M samples/s as in README.md; old → new (new / old).",
+        f"turn, medians of {args.repeats} each, M samples/s as in README.md; old → new (new / old; "
+        "the lowest and highest ratio of a pair taken in turn).",
         "",
         "| scene | " + " | ".join(labels) + " |",
         "|---|" + "---|" * len(labels),
@@ -388,7 +394,9 @@ def write_against(args, rows, labels):
         cells = [r["scene"]]
         for k in labels:
             old, new = r.get(k + "_against"), r.get(k)
-            cells.append(f"{old:.3f} → {new:.3f} ({new / old:.2f})" if old and new else "error")
+            pairs = r.get(k + "_pair_ratios") or []
+            spread = f"; pairs {min(pairs):.2f}–{max(pairs):.2f}" if len(pairs) > 1 else ""
+            cells.append(f"{old:.3f} → {new:.3f} ({new / old:.2f}{spread})" if old and new else "error")
         lines.append("| " + " | ".join(cells) + " |")
     (args.out / "against.md").write_text("\n".join(lines) + "\n")
 
@@ -414,7 +422,9 @@ def write_outputs(args, rows, estimators):
         + (" --bitterli DIR" if args.bitterli else "")
         + f"`, {args.threads} threads, {time.strftime('%Y-%m-%d')}. Millions of samples per second "
         f"(medians of {args.repeats}; {units}): camera samples for pt and bdpt, light paths for "
-        "lt and ppm, mutations for pssmlt (base=bdpt) and mmlt, their bootstrap included.",
+        "lt and ppm, mutations for pssmlt (base=bdpt) and mmlt, their bootstrap included."
+        + (" pt / Mitsuba: the median ratio of the pairs, in parentheses the lowest and highest."
+           if args.mitsuba else ""),
         "",
     ]
     head = "| scene | covers | " + " | ".join(labels)
@@ -429,7 +439,8 @@ def write_outputs(args, rows, estimators):
         cells += [f"{r[k]:.3f}" if r.get(k) is not None else "error" for k in labels]
         if args.mitsuba:
             if "mitsuba_ratio" in r:
-                cells += [f"{r['mitsuba_mpaths']:.3f}", f"{r['mitsuba_ratio']:.2f}"]
+                lo, hi = r["mitsuba_ratio_range"]
+                cells += [f"{r['mitsuba_mpaths']:.3f}", f"{r['mitsuba_ratio']:.2f} ({lo:.2f}–{hi:.2f})"]
                 (extra_ratios if r["extra"] else ratios).append(r["mitsuba_ratio"])
             elif "mitsuba_skipped" in r:
                 cells += [f"— ({r['mitsuba_skipped']})", ""]
