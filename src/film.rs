@@ -420,21 +420,7 @@ impl Film {
 
     /// An empty tile covering `rect` (and the filter margin around it).
     pub fn tile(&self, rect: PixelRect) -> FilmTile {
-        let margin = self.filter.margin();
-        let x1 = rect.x1.min(self.width);
-        let y1 = rect.y1.min(self.height);
-        let rect = PixelRect {
-            x0: rect.x0.min(x1),
-            y0: rect.y0.min(y1),
-            x1,
-            y1,
-        };
-        let buffer = PixelRect {
-            x0: rect.x0.saturating_sub(margin),
-            y0: rect.y0.saturating_sub(margin),
-            x1: rect.x1.saturating_add(margin).min(self.width),
-            y1: rect.y1.saturating_add(margin).min(self.height),
-        };
+        let (rect, buffer) = self.tile_rects(rect);
         let (mut sums, scratch_x, scratch_y) = self
             .spare
             .0
@@ -456,6 +442,32 @@ impl Film {
             scratch_x,
             scratch_y,
         }
+    }
+
+    /// The bytes of pixel sums a tile covering `rect` holds (`tile`).
+    pub fn tile_bytes(&self, rect: PixelRect) -> usize {
+        self.tile_rects(rect).1.pixel_count() * std::mem::size_of::<[f64; 4]>()
+    }
+
+    /// A tile's own rectangle (`rect` clipped to the image) and the pixels it stores: that
+    /// rectangle grown by the filter margin, clipped to the image.
+    fn tile_rects(&self, rect: PixelRect) -> (PixelRect, PixelRect) {
+        let margin = self.filter.margin();
+        let x1 = rect.x1.min(self.width);
+        let y1 = rect.y1.min(self.height);
+        let rect = PixelRect {
+            x0: rect.x0.min(x1),
+            y0: rect.y0.min(y1),
+            x1,
+            y1,
+        };
+        let buffer = PixelRect {
+            x0: rect.x0.saturating_sub(margin),
+            y0: rect.y0.saturating_sub(margin),
+            x1: rect.x1.saturating_add(margin).min(self.width),
+            y1: rect.y1.saturating_add(margin).min(self.height),
+        };
+        (rect, buffer)
     }
 
     /// Keeps the buffers of `tile` (already merged) for later `tile` calls.
