@@ -183,11 +183,13 @@ impl PassCounts {
 
 /// The most pixel-sum memory the finished tiles of one group of passes may hold
 /// (`camera_passes`). Every pass of a group keeps a tile per rectangle until the group is
-/// merged, and memory a process touches for the first time costs a page fault per 4 KiB:
-/// on a 128 × 128 image, 35 passes in one go (the time-based chunk of `render::advance`)
-/// took 6,500 faults and `pt` ran 15–20% slower than in groups of 16 (4,600 faults).
-/// The tiles are reused from group to group (`Film::recycle`).
-const TILE_MEMORY: usize = 8 << 20;
+/// merged. Memory a process touches for the first time costs a page fault per 4 KiB, and
+/// tiles that outgrow the caches are merged from main memory: on a 128 × 128 image, 35
+/// passes in one go (the time-based chunk of `render::advance`) took 6,500–7,800 faults,
+/// groups of 8 MiB 4,000 (`pt` 7% faster), groups of 2 MiB 1,600 (6% faster again); on
+/// 256 × 256 (one pass per group) no slower. The tiles are reused from group to group
+/// (`Film::recycle`).
+const TILE_MEMORY: usize = 2 << 20;
 
 /// Takes samples `passes` of every pixel and adds them to `film`, pass by pass in tile
 /// order (the same bits as one call per pass), each tile's extra after its pass's pixels.
