@@ -204,8 +204,7 @@ pub fn camera_passes<S: CameraSampleFn>(
     estimate: &mut S,
 ) -> PassCounts {
     let rects = film.tiles(TILE_SIZE);
-    let pass_bytes: usize = rects.iter().map(|&r| film.tile_bytes(r)).sum();
-    let group = (TILE_MEMORY / pass_bytes.max(1)).max(1) as u32;
+    let group = passes_per_group(film, &rects);
     let mut total = PassCounts::default();
     let mut first = passes.start;
     while first < passes.end {
@@ -225,6 +224,12 @@ pub fn camera_passes<S: CameraSampleFn>(
         first = end;
     }
     total
+}
+
+/// How many passes over the tiles `rects` of `film` fit in `TILE_MEMORY` (at least one).
+fn passes_per_group(film: &Film, rects: &[PixelRect]) -> u32 {
+    let pass_bytes: usize = rects.iter().map(|&r| film.tile_bytes(r)).sum();
+    (TILE_MEMORY / pass_bytes.max(1)).clamp(1, u32::MAX as usize) as u32
 }
 
 /// `camera_passes` for one group of passes over the tiles `rects`: every task renders its
@@ -456,6 +461,13 @@ mod tests {
             let one_at_a_time = sums(&[1; 12]);
             assert!(sums(&[5, 7]) == one_at_a_time, "wavefront {wavefront}");
             assert!(sums(&[12]) == one_at_a_time, "wavefront {wavefront}");
+            // A chunk of more passes than one group holds (`TILE_MEMORY`) is split into
+            // groups, which merge as one pass at a time too.
+            let film = pt::new(&scene, 5, settings).unwrap().film().clone();
+            let group = passes_per_group(&film, &film.tiles(TILE_SIZE));
+            let passes = 2 * group + 3;
+            let one_at_a_time = sums(&vec![1; passes as usize]);
+            assert!(sums(&[passes]) == one_at_a_time, "wavefront {wavefront}");
         }
     }
 }
