@@ -234,6 +234,10 @@ fn is_finite(value: Rgb) -> bool {
     value.0.iter().all(|c| c.is_finite())
 }
 
+/// One pixel's accumulators: the filter-weighted sums of red, green and blue, then of the
+/// weights.
+type PixelSums = [f64; 4];
+
 /// The whole image's accumulators.
 #[derive(Clone, Debug)]
 pub struct Film {
@@ -241,7 +245,7 @@ pub struct Film {
     height: u32,
     filter: ReconstructionFilter,
     /// Per pixel: Σ w·r, Σ w·g, Σ w·b, Σ w.
-    sums: Vec<[f64; 4]>,
+    sums: Vec<PixelSums>,
     /// Per pixel: Σ w·value of the splats (`image` divides by Z).
     splats: Vec<[f64; 3]>,
     /// The filter's mass over the image per column and per row: Z(i, j) = zx[i] · zy[j].
@@ -287,7 +291,7 @@ pub struct FilmTile {
     image_width: u32,
     image_height: u32,
     filter: ReconstructionFilter,
-    sums: Vec<[f64; 4]>,
+    sums: Vec<PixelSums>,
     samples: u64,
     invalid_samples: u64,
     scratch_x: Vec<f64>,
@@ -446,7 +450,7 @@ impl Film {
 
     /// The bytes of pixel sums a tile covering `rect` holds (`tile`).
     pub fn tile_bytes(&self, rect: PixelRect) -> usize {
-        self.tile_rects(rect).1.pixel_count() * std::mem::size_of::<[f64; 4]>()
+        self.tile_rects(rect).1.pixel_count() * std::mem::size_of::<PixelSums>()
     }
 
     /// A tile's own rectangle (`rect` clipped to the image) and the pixels it stores: that

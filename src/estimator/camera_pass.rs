@@ -34,6 +34,14 @@ pub struct PassCounts {
     pub invalid: u64,
 }
 
+impl std::ops::AddAssign for PassCounts {
+    fn add_assign(&mut self, o: PassCounts) {
+        self.samples += o.samples;
+        self.rays += o.rays;
+        self.invalid += o.invalid;
+    }
+}
+
 /// A tile of one pass, finished: its pixel sums, its counts, and what its samples added
 /// elsewhere (`CameraSampleFn::Extra`).
 pub struct FinishedTile<E> {
@@ -209,7 +217,7 @@ pub fn camera_passes<S: CameraSampleFn>(
     let mut first = passes.start;
     while first < passes.end {
         let end = passes.end.min(first.saturating_add(group));
-        let counts = pass_group(
+        total += pass_group(
             scene,
             film,
             seed,
@@ -218,9 +226,6 @@ pub fn camera_passes<S: CameraSampleFn>(
             pixel_samples,
             estimate,
         );
-        total.samples += counts.samples;
-        total.rays += counts.rays;
-        total.invalid += counts.invalid;
         first = end;
     }
     total
@@ -272,9 +277,7 @@ fn pass_group<S: CameraSampleFn>(
     }
     for t in finished.into_iter().flatten() {
         film.recycle(t.tile);
-        total.samples += t.counts.samples;
-        total.rays += t.counts.rays;
-        total.invalid += t.counts.invalid;
+        total += t.counts;
     }
     total
 }
